@@ -1,0 +1,122 @@
+//! Benchmark problems: domain, material, initial and boundary conditions, body force and the
+//! exact solution. A benchmark knows nothing of how a method maps data.
+
+mod mms_gong;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::material::NeoHookean;
+use crate::params::{ParamError, Params};
+
+pub use mms_gong::GongMms;
+
+/// The kind of value a parameter takes; checked by the experiment layer before a run starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamKind {
+    /// Any finite real number.
+    Real,
+    /// A finite real number > 0.
+    PositiveReal,
+    /// An integer >= 1.
+    PositiveInt,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamDefault {
+    Required,
+    Int(i64),
+    Float(f64),
+}
+
+pub struct ParamSpec {
+    pub key: &'static str,
+    pub kind: ParamKind,
+    pub default: ParamDefault,
+    pub unit: &'static str,
+    pub doc: &'static str,
+}
+
+/// Catalogue entry of a benchmark: what `list-benchmarks` prints and what validation uses.
+pub struct BenchmarkInfo {
+    pub name: &'static str,
+    pub dim: usize,
+    pub source: &'static str,
+    pub description: &'static str,
+    pub params: &'static [ParamSpec],
+    /// Checks that need several parameters at once (stability, physical admissibility).
+    /// Called with every parameter present and of the right kind.
+    pub check: fn(&Params) -> Result<(), ParamError>,
+}
+
+const CATALOG: &[BenchmarkInfo] = &[mms_gong::INFO_1D, mms_gong::INFO_2D];
+
+pub fn catalog() -> &'static [BenchmarkInfo] {
+    CATALOG
+}
+
+pub fn info(name: &str) -> Option<&'static BenchmarkInfo> {
+    CATALOG.iter().find(|b| b.name == name)
+}
+
+pub fn names() -> Vec<&'static str> {
+    CATALOG.iter().map(|b| b.name).collect()
+}
+
+/// Exact state of the material point that started at `X`, in the current configuration.
+pub struct ExactState<const D: usize> {
+    pub displacement: SVector<f64, D>,
+    pub velocity: SVector<f64, D>,
+    /// Cauchy stress.
+    pub stress: SMatrix<f64, D, D>,
+    pub density: f64,
+}
+
+/// A uniform background grid over a box, `cells` cells per direction.
+#[derive(Clone, Copy, Debug)]
+pub struct Domain<const D: usize> {
+    pub lower: SVector<f64, D>,
+    pub upper: SVector<f64, D>,
+    pub cells: usize,
+}
+
+/// Which velocity components are held at zero on the faces of the domain box
+/// (`[axis][0]` the lower face, `[axis][1]` the upper face, the component normal to it).
+pub type FixedFaces<const D: usize> = [[bool; 2]; D];
+
+/// A problem in `D` dimensions as the solver sees it.
+pub trait Problem<const D: usize>: Send + Sync {
+    fn domain(&self) -> Domain<D>;
+    /// Body (material region) as a box inside the domain, filled with `ppc^D` points per cell.
+    fn body(&self) -> (SVector<f64, D>, SVector<f64, D>);
+    fn ppc(&self) -> usize;
+    fn rho0(&self) -> f64;
+    fn material(&self) -> NeoHookean;
+    fn dt(&self) -> f64;
+    fn steps(&self) -> usize;
+    fn fixed_faces(&self) -> FixedFaces<D>;
+    fn initial_velocity(&self, x0: &SVector<f64, D>) -> SVector<f64, D>;
+    /// Body force per unit mass at every particle at time `t`, written into `out`.
+    /// Called once per step, so implementations precompute what does not depend on time.
+    fn body_force(&self, t: f64, out: &mut [SVector<f64, D>]);
+    /// Prepare `body_force` for these reference positions (called once before stepping).
+    fn attach_particles(&mut self, x0: &[SVector<f64, D>]);
+    fn exact(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>>;
+}
+
+/// A problem of either supported dimension.
+pub enum AnyProblem {
+    D1(Box<dyn Problem<1>>),
+    D2(Box<dyn Problem<2>>),
+}
+
+/// Builds the named benchmark from validated parameters.
+pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
+    match name {
+        "mms1d_gong" => Ok(AnyProblem::D1(Box::new(GongMms::<1>::from_params(params)?))),
+        "mms2d_gong" => Ok(AnyProblem::D2(Box::new(GongMms::<2>::from_params(params)?))),
+        other => Err(ParamError::new(
+            "benchmark",
+            format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),
+        )),
+    }
+}

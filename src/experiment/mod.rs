@@ -1,0 +1,78 @@
+//! Experiment files: the YAML schema, validation with file/line/column errors, matrix
+//! expansion and stable run ids. Knows nothing of HDF5 or numerics.
+
+use std::path::PathBuf;
+
+use crate::params::Params;
+
+/// A validated experiment file with its matrix expanded.
+#[derive(Clone, Debug)]
+pub struct Experiment {
+    pub name: String,
+    /// The file it was read from, and its text (copied next to the results so that a
+    /// report can be made from a results directory alone).
+    pub source_path: PathBuf,
+    pub source_text: String,
+    pub benchmark: String,
+    /// Matrix axis names in file order (`method` and `cells` included when they are axes).
+    pub axes: Vec<String>,
+    pub output: OutputSpec,
+    pub expect: Vec<Expectation>,
+    pub figures: Vec<FigureSpec>,
+    /// One entry per run, in expansion order (the cartesian product, last axis fastest).
+    pub runs: Vec<RunSpec>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSpec {
+    /// History sampling interval in steps (t = 0 and the final time are always sampled).
+    pub every: usize,
+}
+
+/// Everything one run needs, fully resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpec {
+    pub experiment: String,
+    /// Human-readable and stable: `<method>-<axis values>-<hash>`; the hash covers the
+    /// canonical resolved configuration, so the same YAML always gives the same ids.
+    pub run_id: String,
+    pub benchmark: String,
+    pub method: String,
+    /// Every benchmark parameter, defaults filled in (method excluded).
+    pub params: Params,
+    /// This run's value of each matrix axis (method included when it is an axis).
+    pub axes: Params,
+    pub output_every: usize,
+    /// The canonical resolved configuration as YAML, stored in each HDF5 file.
+    pub config_yaml: String,
+}
+
+/// One `expect` entry, checked by `mpmlab report --check`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expectation {
+    /// Matrix-axis values the entry applies to (e.g. method: mpm, G: 0.1); empty = all groups.
+    pub select: Params,
+    pub field: String,
+    pub norm: String,
+    pub rate_min: Option<f64>,
+    pub rate_max: Option<f64>,
+    /// Upper bound on the final error of every matching run.
+    pub error_max: Option<f64>,
+    /// Line of the entry in the source file, for messages.
+    pub line: usize,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum FigureKind {
+    /// log10(error) against log10(h) with fitted slopes.
+    Convergence,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FigureSpec {
+    pub kind: FigureKind,
+    pub fields: Vec<String>,
+    pub norm: String,
+    /// Axis whose values become separate curves in one figure (others make separate figures).
+    pub by: Option<String>,
+}
