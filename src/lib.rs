@@ -1,13 +1,20 @@
 //! mpmlab: a research pipeline for the Material Point Method.
 //!
 //! Layers, top to bottom: `experiment` (YAML, matrix), `runner` (runs a matrix in parallel),
-//! `output` (HDF5 layout), `report` (rates, tables, figures), `solver` (the step loop),
-//! `benchmarks`, `shape`, `reconstruct`, `integrate`, `material`.
+//! `output` (HDF5 layout), `report` (rates, tables, figures), `solver` (one run),
+//! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`.
 
 pub mod benchmarks;
+
 pub mod experiment;
+pub mod integrate;
 pub mod material;
 pub mod methods;
-pub mod params;
 pub mod output;
+pub mod params;
+pub mod particles;
+pub mod reconstruct;
 pub mod report;
+pub mod runner;
+pub mod shape;
+pub mod solver;

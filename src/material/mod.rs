@@ -1,8 +1,10 @@
 //! Constitutive models.
 
 mod neo_hookean;
+mod tensor;
 
 pub use neo_hookean::NeoHookean;
+pub use tensor::det;
 
 /// Lame constants from Young's modulus and Poisson's ratio.
 /// (Gong sec 4.5 prints E = lambda(1+mu)(1-2mu)/mu; the inverse used here is the standard

@@ -24,7 +24,8 @@ impl NeoHookean {
                 }
             }
         }
-        s / j
+        // One division instead of D^2.
+        s * (1.0 / j)
     }
 
     /// Small-strain P-wave modulus lambda + 2 mu: the tangent d sigma / d eps at F = I in 1D

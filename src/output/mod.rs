@@ -62,3 +62,15 @@ pub struct RunSummary {
     /// Final error norms keyed by (field, norm), e.g. ("velocity", "l2").
     pub final_norms: BTreeMap<(String, String), f64>,
 }
+
+mod record;
+
+pub use record::{Errors, History, ParticleTable, RunRecord};
+
+mod atomic;
+mod reader;
+mod writer;
+
+pub use atomic::{run_path, write_run};
+pub use reader::read_summary;
+pub use writer::write_hdf5;

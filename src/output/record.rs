@@ -1,0 +1,71 @@
+use super::RunStatus;
+use crate::experiment::RunSpec;
+use crate::methods::Method;
+
+/// Everything written to one run file, as flat row-major arrays so that the layout does
+/// not depend on the dimension at compile time.
+#[derive(Clone, Debug)]
+pub struct RunRecord {
+    pub spec: RunSpec,
+    pub method: Method,
+    pub dim: usize,
+    pub cells: usize,
+    pub ppc: usize,
+    pub h: f64,
+    pub dt: f64,
+    pub t_end: f64,
+    /// Steps actually taken (fewer than planned when the run diverged).
+    pub steps: usize,
+    pub status: RunStatus,
+    pub message: String,
+    pub wall_seconds: f64,
+    pub particles: ParticleTable,
+    pub history: History,
+    pub errors: Errors,
+}
+
+/// `/particles`: reference positions (Np x D), masses and initial volumes.
+#[derive(Clone, Debug, Default)]
+pub struct ParticleTable {
+    pub x0: Vec<f64>,
+    pub mass: Vec<f64>,
+    pub volume0: Vec<f64>,
+}
+
+impl ParticleTable {
+    pub fn len(&self) -> usize {
+        self.mass.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.mass.is_empty()
+    }
+}
+
+/// `/history`: sampled particle states, Nt samples.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    pub time: Vec<f64>,
+    pub step: Vec<i64>,
+    /// Nt x Np x D.
+    pub x: Vec<f64>,
+    /// Nt x Np x D, velocities synchronised to the sample time.
+    pub v: Vec<f64>,
+    /// Nt x Np x D x D, Cauchy stress.
+    pub stress: Vec<f64>,
+    /// Nt x Np.
+    pub density: Vec<f64>,
+}
+
+/// `/errors`: pointwise error magnitudes and their norms at the history samples.
+#[derive(Clone, Debug, Default)]
+pub struct Errors {
+    /// Nt x Np current particle volumes, the quadrature weights of the l2 norm.
+    pub volume: Vec<f64>,
+    /// Per field of `ERROR_FIELDS`: Nt x Np magnitudes |e_p|.
+    pub pointwise: [Vec<f64>; 4],
+    /// Per field: Nt values of sqrt(sum_p V_p |e_p|^2).
+    pub l2: [Vec<f64>; 4],
+    /// Per field: Nt values of sqrt(sum_p |e_p|^2 / Np).
+    pub rms: [Vec<f64>; 4],
+}

@@ -1,0 +1,129 @@
+use std::path::Path;
+
+use hdf5::types::VarLenUnicode;
+use hdf5::{Group, Location};
+use ndarray::{ArrayView, IxDyn};
+
+use super::{RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
+use crate::params::ParamValue;
+
+/// Writes the whole record into a new HDF5 file at `path` (which must not exist).
+pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
+    let file = hdf5::File::create_excl(path)?;
+    let d = r.dim;
+    let np = r.particles.len();
+    let nt = r.history.time.len();
+
+    attr_i64(&file, "schema_version", SCHEMA_VERSION)?;
+    for (name, value) in [
+        ("run_id", r.spec.run_id.as_str()),
+        ("experiment", &r.spec.experiment),
+        ("benchmark", &r.spec.benchmark),
+        ("method", &r.spec.method),
+        ("shape", &r.method.shape.to_string()),
+        ("transfer", &r.method.transfer.to_string()),
+        ("integrator", &r.method.integrator.to_string()),
+        ("status", r.status.as_str()),
+        ("message", &r.message),
+        ("config_yaml", &r.spec.config_yaml),
+        ("mpmlab_version", env!("CARGO_PKG_VERSION")),
+    ] {
+        attr_str(&file, name, value)?;
+    }
+    for (name, value) in [("dim", d), ("cells", r.cells), ("ppc", r.ppc), ("steps", r.steps)] {
+        attr_i64(&file, name, value as i64)?;
+    }
+    for (name, value) in [
+        ("h", r.h),
+        ("dt", r.dt),
+        ("t_end", r.t_end),
+        ("wall_seconds", r.wall_seconds),
+    ] {
+        attr_f64(&file, name, value)?;
+    }
+
+    let params = file.create_group("params")?;
+    for (key, value) in &r.spec.params {
+        attr_param(&params, key, value)?;
+    }
+    let matrix = file.create_group("matrix")?;
+    for (key, value) in &r.spec.axes {
+        attr_param(&matrix, key, value)?;
+    }
+
+    let particles = file.create_group("particles")?;
+    dataset(&particles, "X", &r.particles.x0, &[np, d], "m")?;
+    dataset(&particles, "mass", &r.particles.mass, &[np], "kg")?;
+    dataset(&particles, "volume0", &r.particles.volume0, &[np], "m^D")?;
+
+    let history = file.create_group("history")?;
+    dataset(&history, "time", &r.history.time, &[nt], "s")?;
+    let steps = ArrayView::from_shape(IxDyn(&[nt]), &r.history.step).map_err(shape_error)?;
+    let ds = history.new_dataset_builder().with_data(steps).create("step")?;
+    attr_str(&ds, "units", "1")?;
+    dataset(&history, "x", &r.history.x, &[nt, np, d], "m")?;
+    dataset(&history, "v", &r.history.v, &[nt, np, d], "m/s")?;
+    dataset(&history, "stress", &r.history.stress, &[nt, np, d, d], "Pa")?;
+    dataset(&history, "density", &r.history.density, &[nt, np], "kg/m^D")?;
+
+    let errors = file.create_group("errors")?;
+    dataset(&errors, "time", &r.history.time, &[nt], "s")?;
+    dataset(&errors, "volume", &r.errors.volume, &[nt, np], "m^D")?;
+    let norms = errors.create_group("norms")?;
+    for (f, field) in ERROR_FIELDS.iter().enumerate() {
+        let unit = field_unit(field);
+        dataset(&errors, field, &r.errors.pointwise[f], &[nt, np], unit)?;
+        for (norm, values) in [("l2", &r.errors.l2[f]), ("rms", &r.errors.rms[f])] {
+            let name = format!("{norm}_{field}");
+            dataset(&norms, &name, values, &[nt], unit)?;
+            attr_f64(&norms, &name, values.last().copied().unwrap_or(f64::NAN))?;
+        }
+    }
+    file.flush()?;
+    Ok(())
+}
+
+fn field_unit(field: &str) -> &'static str {
+    match field {
+        "displacement" => "m",
+        "velocity" => "m/s",
+        "stress" => "Pa",
+        _ => "kg/m^D",
+    }
+}
+
+fn shape_error(e: ndarray::ShapeError) -> hdf5::Error {
+    hdf5::Error::from(format!("array shape: {e}"))
+}
+
+fn dataset(group: &Group, name: &str, data: &[f64], shape: &[usize], unit: &str) -> hdf5::Result<()> {
+    let view = ArrayView::from_shape(IxDyn(shape), data).map_err(shape_error)?;
+    let ds = group.new_dataset_builder().with_data(view).create(name)?;
+    attr_str(&ds, "units", unit)
+}
+
+fn attr_param(loc: &Location, key: &str, value: &ParamValue) -> hdf5::Result<()> {
+    match value {
+        ParamValue::Int(i) => attr_i64(loc, key, *i),
+        ParamValue::Float(x) => attr_f64(loc, key, *x),
+        ParamValue::Str(s) => attr_str(loc, key, s),
+    }
+}
+
+fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    let value: VarLenUnicode = value
+        .parse()
+        .map_err(|e| hdf5::Error::from(format!("attribute {name}: {e}")))?;
+    loc.new_attr::<VarLenUnicode>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&value)
+}
+
+fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {
+    loc.new_attr::<f64>().shape(()).create(name)?.write_scalar(&value)
+}
+
+fn attr_i64(loc: &Location, name: &str, value: i64) -> hdf5::Result<()> {
+    loc.new_attr::<i64>().shape(()).create(name)?.write_scalar(&value)
+}

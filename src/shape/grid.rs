@@ -1,0 +1,84 @@
+use nalgebra::SVector;
+
+use crate::benchmarks::Domain;
+
+/// A uniform background grid: `cells` cells of size `h` per direction, nodes numbered
+/// with the first axis fastest.
+#[derive(Clone, Debug)]
+pub struct Grid<const D: usize> {
+    pub lower: SVector<f64, D>,
+    pub h: f64,
+    pub cells: usize,
+    inv_h: f64,
+    strides: [usize; D],
+    num_nodes: usize,
+}
+
+impl<const D: usize> Grid<D> {
+    /// A grid over `domain`; the domain must be a cube (the same h in every direction).
+    pub fn new(domain: &Domain<D>) -> Self {
+        let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
+        let n = domain.cells + 1;
+        let mut strides = [1; D];
+        for k in 1..D {
+            strides[k] = strides[k - 1] * n;
+        }
+        Grid {
+            lower: domain.lower,
+            h,
+            cells: domain.cells,
+            inv_h: 1.0 / h,
+            strides,
+            num_nodes: n.pow(D as u32),
+        }
+    }
+
+    pub fn num_nodes(&self) -> usize {
+        self.num_nodes
+    }
+
+    pub fn nodes_per_dim(&self) -> usize {
+        self.cells + 1
+    }
+
+    /// Flat index of the node with integer coordinates `ijk`.
+    #[inline]
+    pub fn node_index(&self, ijk: [usize; D]) -> usize {
+        (0..D).map(|k| ijk[k] * self.strides[k]).sum()
+    }
+
+    /// Integer coordinates of a flat node index.
+    pub fn node_coords(&self, index: usize) -> [usize; D] {
+        let n = self.nodes_per_dim();
+        std::array::from_fn(|k| (index / self.strides[k]) % n)
+    }
+
+    /// The cell containing `x` and the local coordinates in [0, 1] within it, or `None`
+    /// when `x` lies outside the grid (or is not finite). A point on an interior cell face
+    /// belongs to the upper cell; a point on the upper boundary to the last cell.
+    #[inline]
+    pub fn locate(&self, x: &SVector<f64, D>) -> Option<([usize; D], SVector<f64, D>)> {
+        let mut cell = [0usize; D];
+        let mut xi = SVector::<f64, D>::zeros();
+        for k in 0..D {
+            let s = (x[k] - self.lower[k]) * self.inv_h;
+            // Written so that NaN fails the test.
+            if !(s >= 0.0 && s <= self.cells as f64) {
+                return None;
+            }
+            let c = (s as usize).min(self.cells - 1);
+            cell[k] = c;
+            xi[k] = s - c as f64;
+        }
+        Some((cell, xi))
+    }
+
+    #[inline]
+    pub fn inv_h(&self) -> f64 {
+        self.inv_h
+    }
+
+    pub fn stride(&self, axis: usize) -> usize {
+        self.strides[axis]
+    }
+}

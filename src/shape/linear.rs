@@ -1,0 +1,49 @@
+use nalgebra::SVector;
+
+use super::{Grid, Shape};
+
+/// The piecewise-linear hat of Gong eq 4.8, a tensor product in 2D: 2^D nodes per point.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LinearHat;
+
+impl<const D: usize> Shape<D> for LinearHat {
+    fn nodes_per_point(&self) -> usize {
+        1 << D
+    }
+
+    #[inline]
+    fn eval(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> bool {
+        let Some((cell, xi)) = grid.locate(x) else {
+            return false;
+        };
+        let base = grid.node_index(cell);
+        let inv_h = grid.inv_h();
+        for corner in 0..(1usize << D) {
+            let mut index = base;
+            let mut w = 1.0;
+            let mut g = SVector::<f64, D>::repeat(inv_h);
+            for k in 0..D {
+                let upper = corner >> k & 1 == 1;
+                let (wk, dk) = if upper { (xi[k], 1.0) } else { (1.0 - xi[k], -1.0) };
+                if upper {
+                    index += grid.stride(k);
+                }
+                w *= wk;
+                for l in 0..D {
+                    g[l] *= if l == k { dk } else { wk };
+                }
+            }
+            node[corner] = index as u32;
+            weight[corner] = w;
+            grad[corner] = g;
+        }
+        true
+    }
+}

@@ -1,0 +1,29 @@
+//! Basis functions on the background grid and the per-particle tables of their values.
+
+mod grid;
+mod linear;
+mod stencils;
+
+use nalgebra::SVector;
+
+pub use grid::Grid;
+pub use linear::LinearHat;
+pub use stencils::Stencils;
+
+/// A family of grid basis functions N_i(x).
+pub trait Shape<const D: usize>: Sync {
+    /// How many nodes one point's stencil lists (entries beyond the true support carry
+    /// zero weight and gradient).
+    fn nodes_per_point(&self) -> usize;
+
+    /// Fills the nodes, values N_i(x) and gradients grad N_i(x) of the stencil of `x`.
+    /// Returns false when `x` is outside the grid.
+    fn eval(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> bool;
+}

@@ -1,0 +1,158 @@
+use nalgebra::SVector;
+
+use super::{Grid, Shape};
+
+/// Shape-function values of every particle, `per_point` entries each, stored flat so
+/// that the transfer loops walk memory in order and nothing is allocated per step.
+pub struct Stencils<const D: usize> {
+    pub per_point: usize,
+    pub node: Vec<u32>,
+    pub weight: Vec<f64>,
+    pub grad: Vec<SVector<f64, D>>,
+}
+
+impl<const D: usize> Stencils<D> {
+    pub fn new(per_point: usize, particles: usize) -> Self {
+        let n = per_point * particles;
+        Stencils {
+            per_point,
+            node: vec![0; n],
+            weight: vec![0.0; n],
+            grad: vec![SVector::zeros(); n],
+        }
+    }
+
+    /// Evaluates the shape functions at every position; on failure returns the index of
+    /// the first particle outside the grid.
+    pub fn update<S: Shape<D>>(
+        &mut self,
+        shape: &S,
+        grid: &Grid<D>,
+        positions: &[SVector<f64, D>],
+    ) -> Result<(), usize> {
+        let k = self.per_point;
+        let chunks = self
+            .node
+            .chunks_exact_mut(k)
+            .zip(self.weight.chunks_exact_mut(k))
+            .zip(self.grad.chunks_exact_mut(k));
+        for (p, ((node, weight), grad)) in chunks.enumerate() {
+            if !shape.eval(grid, &positions[p], node, weight, grad) {
+                return Err(p);
+            }
+        }
+        Ok(())
+    }
+
+    /// Entries of particle `p`: (node, N, grad N).
+    #[inline]
+    pub fn of(&self, p: usize) -> impl Iterator<Item = (usize, f64, &SVector<f64, D>)> {
+        let range = p * self.per_point..(p + 1) * self.per_point;
+        self.node[range.clone()]
+            .iter()
+            .zip(&self.weight[range.clone()])
+            .zip(&self.grad[range])
+            .map(|((&i, &w), g)| (i as usize, w, g))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::benchmarks::Domain;
+    use crate::shape::LinearHat;
+
+    fn grid<const D: usize>(cells: usize) -> Grid<D> {
+        Grid::new(&Domain {
+            lower: SVector::repeat(-0.5),
+            upper: SVector::repeat(1.5),
+            cells,
+        })
+    }
+
+    /// Deterministic pseudo-random points in the grid (no RNG dependency needed).
+    fn points<const D: usize>(n: usize) -> Vec<SVector<f64, D>> {
+        let mut state = 0x9e3779b97f4a7c15u64;
+        (0..n)
+            .map(|_| {
+                SVector::from_fn(|_, _| {
+                    state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    -0.5 + 2.0 * ((state >> 11) as f64 / (1u64 << 53) as f64)
+                })
+            })
+            .collect()
+    }
+
+    fn node_position<const D: usize>(g: &Grid<D>, i: usize) -> SVector<f64, D> {
+        let ijk = g.node_coords(i);
+        SVector::from_fn(|k, _| g.lower[k] + ijk[k] as f64 * g.h)
+    }
+
+    /// Partition of unity, zero gradient sum, linear reproduction and its gradient.
+    fn check_consistency<const D: usize>() {
+        let g = grid::<D>(7);
+        let xs = points::<D>(500);
+        let mut st = Stencils::new(1 << D, xs.len());
+        st.update(&LinearHat, &g, &xs).unwrap();
+        for (p, x) in xs.iter().enumerate() {
+            let sum_w: f64 = st.of(p).map(|(_, w, _)| w).sum();
+            let sum_g: SVector<f64, D> = st.of(p).map(|(_, _, gr)| *gr).sum();
+            let sum_wx: SVector<f64, D> = st.of(p).map(|(i, w, _)| node_position(&g, i) * w).sum();
+            let sum_gx: nalgebra::SMatrix<f64, D, D> = st
+                .of(p)
+                .map(|(i, _, gr)| node_position(&g, i) * gr.transpose())
+                .sum();
+            assert!((sum_w - 1.0).abs() < 1e-14);
+            assert!(sum_g.norm() < 1e-12);
+            assert!((sum_wx - x).norm() < 1e-14);
+            assert!((sum_gx - nalgebra::SMatrix::<f64, D, D>::identity()).norm() < 1e-12);
+            assert!(st.of(p).all(|(_, w, _)| w >= 0.0));
+        }
+    }
+
+    #[test]
+    fn linear_hat_consistency_1d() {
+        check_consistency::<1>();
+    }
+
+    #[test]
+    fn linear_hat_consistency_2d() {
+        check_consistency::<2>();
+    }
+
+    /// Gradients agree with central differences of the values away from cell faces.
+    #[test]
+    fn linear_hat_gradient_matches_finite_differences_2d() {
+        let g = grid::<2>(5);
+        let x = SVector::<f64, 2>::new(0.31, 0.77);
+        let value = |y: &SVector<f64, 2>, node: usize| {
+            let mut st = Stencils::new(4, 1);
+            st.update(&LinearHat, &g, std::slice::from_ref(y)).unwrap();
+            let w = st.of(0).find(|(i, _, _)| *i == node).map_or(0.0, |(_, w, _)| w);
+            w
+        };
+        let mut st = Stencils::new(4, 1);
+        st.update(&LinearHat, &g, std::slice::from_ref(&x)).unwrap();
+        let eps = 1e-6;
+        for (i, _, grad) in st.of(0) {
+            for k in 0..2 {
+                let mut xp = x;
+                let mut xm = x;
+                xp[k] += eps;
+                xm[k] -= eps;
+                let fd = (value(&xp, i) - value(&xm, i)) / (2.0 * eps);
+                assert!((fd - grad[k]).abs() < 1e-8, "node {i} axis {k}: {fd} vs {}", grad[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn outside_points_are_reported() {
+        let g = grid::<2>(4);
+        let xs = vec![SVector::<f64, 2>::new(0.0, 0.0), SVector::<f64, 2>::new(1.6, 0.0)];
+        let mut st = Stencils::new(4, 2);
+        assert_eq!(st.update(&LinearHat, &g, &xs), Err(1));
+        let nan = vec![SVector::<f64, 2>::new(f64::NAN, 0.0)];
+        assert_eq!(Stencils::new(4, 1).update(&LinearHat, &g, &nan), Err(0));
+    }
+}

@@ -1,0 +1,212 @@
+//! One run: build the problem, seed particles, step, sample, and return the record.
+
+mod recorder;
+
+use std::time::Instant;
+
+use nalgebra::SVector;
+
+use crate::benchmarks::{self, AnyProblem, Problem};
+use crate::experiment::RunSpec;
+use crate::integrate::leapfrog::{self, FixedDof};
+use crate::integrate::Divergence;
+use crate::methods::{self, Method, ShapeKind};
+use crate::output::{ParticleTable, RunRecord, RunStatus};
+use crate::particles::Particles;
+use crate::reconstruct::{particles_to_grid, GridState};
+use crate::shape::{Grid, LinearHat, Shape, Stencils};
+
+use recorder::Recorder;
+
+/// Runs one configuration. Never panics on bad numbers: a run that cannot start is
+/// `failed`, a run that blows up is `diverged`, each with the reason in `message`.
+pub fn simulate(spec: &RunSpec) -> RunRecord {
+    let started = Instant::now();
+    let mut record = match prepare(spec) {
+        Ok((method, AnyProblem::D1(problem))) => run_with_method(spec, method, problem),
+        Ok((method, AnyProblem::D2(problem))) => run_with_method(spec, method, problem),
+        Err(message) => failed_record(spec, message),
+    };
+    record.wall_seconds = started.elapsed().as_secs_f64();
+    record
+}
+
+fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
+    let preset = methods::preset(&spec.method).ok_or_else(|| {
+        format!(
+            "unknown method '{}'; valid: {}",
+            spec.method,
+            methods::preset_names().join(", ")
+        )
+    })?;
+    let problem = benchmarks::build(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
+    Ok((preset.method, problem))
+}
+
+fn run_with_method<const D: usize>(
+    spec: &RunSpec,
+    method: Method,
+    problem: Box<dyn Problem<D>>,
+) -> RunRecord {
+    match method.shape {
+        ShapeKind::Linear => Run::new(spec, method, problem, LinearHat).execute(),
+    }
+}
+
+/// The state of one run in progress.
+struct Run<'a, const D: usize, S: Shape<D>> {
+    spec: &'a RunSpec,
+    method: Method,
+    problem: Box<dyn Problem<D>>,
+    shape: S,
+    grid: Grid<D>,
+    particles: Particles<D>,
+    stencils: Stencils<D>,
+    nodes: GridState<D>,
+    fixed: Vec<FixedDof>,
+    body_force: Vec<SVector<f64, D>>,
+    recorder: Recorder,
+}
+
+impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
+    fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>, shape: S) -> Self {
+        let grid = Grid::new(&problem.domain());
+        let particles = Particles::seed(problem.as_ref(), &grid);
+        problem.attach_particles(&particles.x0);
+        let fixed = fixed_dofs(&grid, &problem.fixed_faces());
+        let n = particles.len();
+        Run {
+            spec,
+            method,
+            stencils: Stencils::new(shape.nodes_per_point(), n),
+            shape,
+            nodes: GridState::new(grid.num_nodes()),
+            grid,
+            particles,
+            fixed,
+            body_force: vec![SVector::zeros(); n],
+            recorder: Recorder::new(),
+            problem,
+        }
+    }
+
+    fn execute(mut self) -> RunRecord {
+        let (steps, outcome) = self.step_all();
+        let (status, message) = match outcome {
+            Ok(()) => (RunStatus::Ok, String::new()),
+            Err((step, reason)) => (
+                RunStatus::Diverged,
+                format!("step {step} (t = {:e}): {reason}", step as f64 * self.problem.dt()),
+            ),
+        };
+        self.into_record(steps, status, message)
+    }
+
+    /// Steps to the final time; returns the steps completed and, on divergence, the step
+    /// that failed and why.
+    fn step_all(&mut self) -> (usize, Result<(), (usize, Divergence)>) {
+        let dt = self.problem.dt();
+        let steps = self.problem.steps();
+        let every = self.spec.output_every;
+        let material = self.problem.material();
+        let particle_mass = self.particles.mass.iter().cloned().fold(0.0, f64::max);
+        let mut synced = vec![SVector::zeros(); self.particles.len()];
+        if let Err(p) = self.stencils.update(&self.shape, &self.grid, &self.particles.x) {
+            return (0, Err((0, Divergence::LeftGrid { particle: p })));
+        }
+        for s in 0..=steps {
+            let t = s as f64 * dt;
+            self.problem.body_force(t, &mut self.body_force);
+            particles_to_grid(&self.stencils, &self.particles, &self.body_force, &mut self.nodes);
+            let kick = if s == 0 { 0.5 * dt } else { dt };
+            leapfrog::solve_grid(&mut self.nodes, &self.fixed, kick, particle_mass);
+            if s == 0 || s == steps || (every > 0 && s % every == 0) {
+                let half = if s == 0 { 0.0 } else { 0.5 * dt };
+                leapfrog::synchronized_velocity(
+                    &self.stencils,
+                    &self.particles,
+                    &self.nodes,
+                    half,
+                    &mut synced,
+                );
+                self.recorder
+                    .sample(s, t, &self.particles, &synced, self.problem.as_ref());
+            }
+            if s == steps {
+                break;
+            }
+            let updated = leapfrog::update_particles(
+                &self.stencils,
+                &mut self.particles,
+                &self.nodes,
+                kick,
+                dt,
+                &material,
+            );
+            if let Err(reason) = updated {
+                return (s, Err((s + 1, reason)));
+            }
+            if let Err(p) = self.stencils.update(&self.shape, &self.grid, &self.particles.x) {
+                return (s, Err((s + 1, Divergence::LeftGrid { particle: p })));
+            }
+        }
+        (steps, Ok(()))
+    }
+
+    fn into_record(self, steps: usize, status: RunStatus, message: String) -> RunRecord {
+        let mut record = failed_record(self.spec, message);
+        record.method = self.method;
+        record.dim = D;
+        record.h = self.grid.h;
+        record.dt = self.problem.dt();
+        record.t_end = self.problem.dt() * self.problem.steps() as f64;
+        record.steps = steps;
+        record.status = status;
+        record.particles = ParticleTable {
+            x0: self.particles.x0.iter().flat_map(|x| x.iter().copied()).collect(),
+            mass: self.particles.mass,
+            volume0: self.particles.volume0,
+        };
+        record.history = self.recorder.history;
+        record.errors = self.recorder.errors;
+        record
+    }
+}
+
+/// The velocity components held at zero: the normal component on each fixed face.
+fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<FixedDof> {
+    let mut fixed = Vec::new();
+    for i in 0..grid.num_nodes() {
+        let ijk = grid.node_coords(i);
+        for k in 0..D {
+            let on_lower = faces[k][0] && ijk[k] == 0;
+            let on_upper = faces[k][1] && ijk[k] == grid.cells;
+            if on_lower || on_upper {
+                fixed.push((i as u32, k as u8));
+            }
+        }
+    }
+    fixed
+}
+
+/// A record with identity fields only; the run fills in the rest.
+fn failed_record(spec: &RunSpec, message: String) -> RunRecord {
+    let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
+    RunRecord {
+        spec: spec.clone(),
+        method: methods::preset(&spec.method).map_or(methods::presets()[0].method, |p| p.method),
+        dim: benchmarks::info(&spec.benchmark).map_or(0, |b| b.dim),
+        cells: int("cells"),
+        ppc: int("ppc"),
+        h: f64::NAN,
+        dt: f64::NAN,
+        t_end: crate::params::get_f64(&spec.params, "t_end").unwrap_or(f64::NAN),
+        steps: 0,
+        status: RunStatus::Failed,
+        message,
+        wall_seconds: 0.0,
+        particles: ParticleTable::default(),
+        history: Default::default(),
+        errors: Default::default(),
+    }
+}

@@ -1,0 +1,79 @@
+use nalgebra::SVector;
+
+use crate::benchmarks::Problem;
+use crate::output::{Errors, History};
+use crate::particles::Particles;
+
+/// Appends sampled particle states and their errors against the exact solution.
+pub struct Recorder {
+    pub history: History,
+    pub errors: Errors,
+}
+
+impl Recorder {
+    pub fn new() -> Self {
+        Recorder {
+            history: History::default(),
+            errors: Errors::default(),
+        }
+    }
+
+    /// Records the state at step `step`, time `t`, with `velocity` synchronised to `t`.
+    pub fn sample<const D: usize>(
+        &mut self,
+        step: usize,
+        t: f64,
+        particles: &Particles<D>,
+        velocity: &[SVector<f64, D>],
+        problem: &dyn Problem<D>,
+    ) {
+        let h = &mut self.history;
+        h.time.push(t);
+        h.step.push(step as i64);
+        let rho0 = problem.rho0();
+        for p in 0..particles.len() {
+            h.x.extend(particles.x[p].iter());
+            h.v.extend(velocity[p].iter());
+            // Row-major D x D (nalgebra stores columns; the transpose's columns are rows).
+            h.stress.extend(particles.stress[p].transpose().iter());
+            h.density.push(rho0 / particles.j[p]);
+        }
+        self.sample_errors(t, particles, velocity, problem);
+    }
+
+    fn sample_errors<const D: usize>(
+        &mut self,
+        t: f64,
+        particles: &Particles<D>,
+        velocity: &[SVector<f64, D>],
+        problem: &dyn Problem<D>,
+    ) {
+        let e = &mut self.errors;
+        let rho0 = problem.rho0();
+        let mut sum_v = [0.0; 4];
+        let mut sum_n = [0.0; 4];
+        for p in 0..particles.len() {
+            let Some(exact) = problem.exact(&particles.x0[p], t) else {
+                continue;
+            };
+            let volume = particles.volume(p);
+            let pointwise = [
+                (particles.x[p] - particles.x0[p] - exact.displacement).norm(),
+                (velocity[p] - exact.velocity).norm(),
+                (particles.stress[p] - exact.stress).norm(),
+                (rho0 / particles.j[p] - exact.density).abs(),
+            ];
+            e.volume.push(volume);
+            for (f, &value) in pointwise.iter().enumerate() {
+                e.pointwise[f].push(value);
+                sum_v[f] += volume * value * value;
+                sum_n[f] += value * value;
+            }
+        }
+        let n = particles.len() as f64;
+        for f in 0..4 {
+            e.l2[f].push(sum_v[f].sqrt());
+            e.rms[f].push((sum_n[f] / n).sqrt());
+        }
+    }
+}
