@@ -1,2 +1,110 @@
 //! Reports over a results directory: summary.csv, rates.csv, figures and report.md, and
 //! the `--check` of an experiment's expectations.
+//!
+//! Runs that differ only in the refinement axis (`cells`) form a group; each group's final
+//! errors are fitted against h as a power law per field and norm.
+
+mod check;
+mod figures;
+mod fit;
+mod format;
+mod group;
+mod markdown;
+mod plot;
+mod tables;
+
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+pub use check::{check, CheckFailure};
+
+use crate::experiment::Experiment;
+use crate::output::{RunSummary, ERROR_FIELDS, NORMS};
+use crate::params::Params;
+
+/// The fitted convergence rate of one (group, field, norm): `log10(error) = intercept +
+/// rate * log10(h)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RateRow {
+    pub experiment: String,
+    /// `key=value` pairs of `group_axes`, sorted by key; empty when cells is the only axis.
+    pub group: String,
+    /// The run axes minus the refinement axis.
+    pub group_axes: Params,
+    pub field: String,
+    pub norm: String,
+    pub rate: f64,
+    pub intercept: f64,
+    /// Coefficient of determination of the fit in log-log space.
+    pub r2: f64,
+    /// Number of runs in the fit.
+    pub n: usize,
+    pub h_min: f64,
+    pub h_max: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    pub rates: Vec<RateRow>,
+    /// Written figures, relative to the report directory.
+    pub figures: Vec<PathBuf>,
+}
+
+/// Writes summary.csv, rates.csv, figures/*.png and report.md into `dir`; report.md gets a
+/// "Checks" section when `check` is given.
+pub fn write_report(
+    dir: &Path,
+    experiment: &Experiment,
+    runs: &[RunSummary],
+    check: Option<&[CheckFailure]>,
+) -> io::Result<Report> {
+    let rates = fit_rates(experiment, runs);
+    let figures = figures::plan(experiment, runs);
+    fs::create_dir_all(dir.join("figures"))?;
+    fs::write(
+        dir.join("summary.csv"),
+        tables::summary_csv(experiment, runs),
+    )?;
+    fs::write(dir.join("rates.csv"), tables::rates_csv(&rates))?;
+    for figure in &figures {
+        plot::render(&dir.join(&figure.file), figure)?;
+    }
+    let md = markdown::report_md(experiment, runs, &rates, &figures, check);
+    fs::write(dir.join("report.md"), md)?;
+    Ok(Report {
+        rates,
+        figures: figures.into_iter().map(|f| f.file).collect(),
+    })
+}
+
+/// Fits every (group, field, norm) with at least two finished runs of positive, finite
+/// error, sorted by group, then field and norm in `ERROR_FIELDS` and `NORMS` order.
+pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
+    let mut rows = Vec::new();
+    for g in group::group_runs(runs, &[group::REFINEMENT_AXIS]) {
+        for field in ERROR_FIELDS {
+            for norm in NORMS {
+                let points = group::usable_points(&g.runs, field, norm);
+                let Some(line) = fit::fit_loglog(&points) else {
+                    continue;
+                };
+                let (h_min, h_max) = fit::min_max(points.iter().map(|p| p.0));
+                rows.push(RateRow {
+                    experiment: experiment.name.clone(),
+                    group: g.label.clone(),
+                    group_axes: g.axes.clone(),
+                    field: field.to_string(),
+                    norm: norm.to_string(),
+                    rate: line.slope,
+                    intercept: line.intercept,
+                    r2: line.r2,
+                    n: points.len(),
+                    h_min,
+                    h_max,
+                });
+            }
+        }
+    }
+    rows
+}

@@ -1,0 +1,163 @@
+//! `report --check`: holds the fitted rates and final errors against the experiment's
+//! `expect` entries.
+
+use std::fmt;
+
+use super::format::{exact, general};
+use super::group::{label, ordered_runs, selects};
+use super::RateRow;
+use crate::experiment::{Expectation, Experiment};
+use crate::output::{RunStatus, RunSummary};
+
+/// One unmet expectation. `message` names the group, field, norm, value and bound; the
+/// `Display` form prefixes the expectation's line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckFailure {
+    pub line: usize,
+    pub message: String,
+}
+
+impl fmt::Display for CheckFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}: {}", self.line, self.message)
+    }
+}
+
+/// Evaluates every `expect` entry; an empty vector means all passed.
+///
+/// Rate bounds apply to every fitted rate whose group matches the selector, and fail when
+/// none does. `error_max` applies to every run whose axes match the selector (the
+/// refinement axis included): each must have finished with a final error within the bound.
+pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) -> Vec<CheckFailure> {
+    experiment
+        .expect
+        .iter()
+        .flat_map(|e| {
+            let mut messages = check_rates(e, rates);
+            messages.extend(check_errors(e, runs));
+            messages.into_iter().map(|message| CheckFailure {
+                line: e.line,
+                message,
+            })
+        })
+        .collect()
+}
+
+/// A one-line statement of what `e` requires, e.g. `method=mpm velocity l2: rate >= 1.8`.
+pub fn describe(e: &Expectation) -> String {
+    let bounds: Vec<String> = [
+        e.rate_min.map(|v| format!("rate >= {}", exact(v))),
+        e.rate_max.map(|v| format!("rate <= {}", exact(v))),
+        e.error_max.map(|v| format!("error <= {}", exact(v))),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    format!("{}: {}", subject(&label(&e.select), e), bounds.join(", "))
+}
+
+fn check_rates(e: &Expectation, rates: &[RateRow]) -> Vec<String> {
+    if e.rate_min.is_none() && e.rate_max.is_none() {
+        return Vec::new();
+    }
+    let rows: Vec<&RateRow> = rates
+        .iter()
+        .filter(|r| r.field == e.field && r.norm == e.norm && selects(&e.select, &r.group_axes))
+        .collect();
+    if rows.is_empty() {
+        return vec![format!(
+            "no fitted rate for {}",
+            subject(&label(&e.select), e)
+        )];
+    }
+    let mut messages = Vec::new();
+    for row in rows {
+        let at = subject(&row.group, e);
+        if let Some(min) = e.rate_min.filter(|&min| row.rate < min) {
+            messages.push(format!(
+                "{at}: rate {} < rate_min {}",
+                beside(row.rate, min),
+                exact(min)
+            ));
+        }
+        if let Some(max) = e.rate_max.filter(|&max| row.rate > max) {
+            messages.push(format!(
+                "{at}: rate {} > rate_max {}",
+                beside(row.rate, max),
+                exact(max)
+            ));
+        }
+    }
+    messages
+}
+
+fn check_errors(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
+    let Some(max) = e.error_max else {
+        return Vec::new();
+    };
+    let matching: Vec<&RunSummary> = ordered_runs(runs)
+        .into_iter()
+        .filter(|run| selects(&e.select, &run.axes))
+        .collect();
+    if matching.is_empty() {
+        return vec![format!("no run for {}", subject(&label(&e.select), e))];
+    }
+    matching
+        .into_iter()
+        .filter_map(|run| {
+            let at = subject(&label(&run.axes), e);
+            let error = run.final_norms.get(&(e.field.clone(), e.norm.clone()));
+            match (run.status, error) {
+                (RunStatus::Ok, Some(&error)) if error <= max => None,
+                (RunStatus::Ok, Some(&error)) => Some(format!(
+                    "{at}: error {} > error_max {} (run {})",
+                    beside(error, max),
+                    exact(max),
+                    run.run_id
+                )),
+                (RunStatus::Ok, None) => Some(format!("{at}: no final error (run {})", run.run_id)),
+                (status, _) => Some(format!(
+                    "{at}: run {} {}: {}",
+                    run.run_id,
+                    status.as_str(),
+                    run.message
+                )),
+            }
+        })
+        .collect()
+}
+
+/// `<group> <field> <norm>`, or just `<field> <norm>` when the group has no axes.
+fn subject(group: &str, e: &Expectation) -> String {
+    let what = format!("{} {}", e.field, e.norm);
+    if group.is_empty() {
+        what
+    } else {
+        format!("{group} {what}")
+    }
+}
+
+/// `value` with just enough digits to show on which side of `bound` it lies, so that a
+/// failure never reads `rate 1.80 < rate_min 1.8`.
+fn beside(value: f64, bound: f64) -> String {
+    (3..=17)
+        .map(|sig| general(value, sig))
+        .find(|text| {
+            text.parse::<f64>()
+                .is_ok_and(|shown| shown.partial_cmp(&bound) == value.partial_cmp(&bound))
+        })
+        .unwrap_or_else(|| exact(value))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_near_a_bound_get_more_digits() {
+        assert_eq!(beside(0.31234, 1.8), "0.312");
+        assert_eq!(beside(1.79996, 1.8), "1.79996");
+        assert_eq!(beside(2.2e-3, 1e-3), "0.0022");
+        assert_eq!(beside(f64::NAN, 1e-3), "NaN");
+    }
+}

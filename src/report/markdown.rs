@@ -1,0 +1,175 @@
+//! report.md: everything a reader needs on one page. Wall-clock times are left out so that
+//! rerunning an identical experiment leaves the committed report unchanged.
+
+use std::fmt::Write;
+
+use super::check::{describe, CheckFailure};
+use super::figures::Figure;
+use super::format::{general, rate};
+use super::group::{label, ordered_runs};
+use super::RateRow;
+use crate::experiment::Experiment;
+use crate::output::{RunStatus, RunSummary};
+
+pub fn report_md(
+    experiment: &Experiment,
+    runs: &[RunSummary],
+    rates: &[RateRow],
+    figures: &[Figure],
+    check: Option<&[CheckFailure]>,
+) -> String {
+    let runs = ordered_runs(runs);
+    let mut md = format!("# {}\n\n", experiment.name);
+    overview(&mut md, experiment, &runs);
+    runs_table(&mut md, experiment, &runs);
+    rates_table(&mut md, rates);
+    unfinished(&mut md, &runs);
+    if !figures.is_empty() {
+        md.push_str("## Figures\n\n");
+        for figure in figures {
+            let link = figure.file.to_string_lossy().replace('\\', "/");
+            let _ = writeln!(md, "![{}]({link})\n", figure.title);
+        }
+    }
+    if let Some(failures) = check {
+        checks(&mut md, experiment, failures);
+    }
+    md
+}
+
+fn overview(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
+    let _ = writeln!(md, "- Benchmark: `{}`", experiment.benchmark);
+    for axis in &experiment.axes {
+        let mut values: Vec<String> = Vec::new();
+        for value in runs.iter().filter_map(|r| r.axes.get(axis)) {
+            let text = value.to_string();
+            if !values.contains(&text) {
+                values.push(text);
+            }
+        }
+        let _ = writeln!(md, "- Axis `{axis}`: {}", values.join(", "));
+    }
+    let count = |status| runs.iter().filter(|r| r.status == status).count();
+    let _ = writeln!(
+        md,
+        "- Runs: {} ({} ok, {} diverged, {} failed)\n",
+        runs.len(),
+        count(RunStatus::Ok),
+        count(RunStatus::Diverged),
+        count(RunStatus::Failed)
+    );
+}
+
+fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
+    md.push_str("## Runs\n\n");
+    let mut header = vec!["run".to_string()];
+    header.extend(experiment.axes.iter().cloned());
+    header.extend(["h", "status", "steps"].map(String::from));
+    let rows = runs.iter().map(|run| {
+        let mut row = vec![format!("`{}`", run.run_id)];
+        row.extend(experiment.axes.iter().map(|axis| {
+            run.axes
+                .get(axis)
+                .map(ToString::to_string)
+                .unwrap_or_default()
+        }));
+        row.extend([
+            h_text(run.h),
+            run.status.as_str().to_string(),
+            run.steps.to_string(),
+        ]);
+        row
+    });
+    table(md, &header, rows);
+}
+
+fn rates_table(md: &mut String, rates: &[RateRow]) {
+    md.push_str("## Convergence rates\n\n");
+    if rates.is_empty() {
+        md.push_str(
+            "No rate could be fitted: no group has two finished runs with a positive error.\n\n",
+        );
+        return;
+    }
+    md.push_str(
+        "Least-squares slope of log10(final error) against log10(h), over the runs that finished.\n\n",
+    );
+    let header = ["group", "field", "norm", "rate", "r2", "points", "h range"].map(String::from);
+    let rows = rates.iter().map(|r| {
+        vec![
+            if r.group.is_empty() {
+                "(all)".to_string()
+            } else {
+                r.group.clone()
+            },
+            r.field.clone(),
+            r.norm.clone(),
+            rate(r.rate),
+            format!("{:.3}", r.r2),
+            r.n.to_string(),
+            format!("{} to {}", h_text(r.h_min), h_text(r.h_max)),
+        ]
+    });
+    table(md, &header, rows);
+}
+
+/// Diverged and failed runs are left out of fits and figures; this says which and why.
+fn unfinished(md: &mut String, runs: &[&RunSummary]) {
+    let bad: Vec<&&RunSummary> = runs.iter().filter(|r| r.status != RunStatus::Ok).collect();
+    if bad.is_empty() {
+        return;
+    }
+    md.push_str(
+        "## Diverged and failed runs\n\nThese runs are left out of the rates and figures.\n\n",
+    );
+    let header = ["run", "axes", "status", "message"].map(String::from);
+    let rows = bad.iter().map(|run| {
+        vec![
+            format!("`{}`", run.run_id),
+            label(&run.axes),
+            run.status.as_str().to_string(),
+            run.message.clone(),
+        ]
+    });
+    table(md, &header, rows);
+}
+
+fn checks(md: &mut String, experiment: &Experiment, failures: &[CheckFailure]) {
+    md.push_str("## Checks\n\n");
+    if experiment.expect.is_empty() {
+        md.push_str("The experiment states no expectations.\n\n");
+        return;
+    }
+    for e in &experiment.expect {
+        let mine: Vec<&CheckFailure> = failures.iter().filter(|f| f.line == e.line).collect();
+        let verdict = if mine.is_empty() { "pass" } else { "FAIL" };
+        let _ = writeln!(md, "- **{verdict}** line {}: {}", e.line, describe(e));
+        for failure in mine {
+            let _ = writeln!(md, "  - {}", failure.message);
+        }
+    }
+    md.push('\n');
+}
+
+fn table(md: &mut String, header: &[String], rows: impl Iterator<Item = Vec<String>>) {
+    let line = |cells: &[String]| {
+        let cells: Vec<String> = cells.iter().map(|c| cell(c)).collect();
+        format!("| {} |\n", cells.join(" | "))
+    };
+    md.push_str(&line(header));
+    md.push_str(&line(&vec!["---".to_string(); header.len()]));
+    for row in rows {
+        md.push_str(&line(&row));
+    }
+    md.push('\n');
+}
+
+/// Cell sizes are often 1/2^k: six digits show 1/64 = 0.015625 exactly.
+fn h_text(h: f64) -> String {
+    general(h, 6)
+}
+
+/// Table cells cannot hold pipes or line breaks.
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+}

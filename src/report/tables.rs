@@ -1,0 +1,122 @@
+//! summary.csv and rates.csv, written by hand: the quoting rules are all we need of CSV.
+
+use std::borrow::Cow;
+
+use super::format::exact;
+use super::group::ordered_runs;
+use super::RateRow;
+use crate::experiment::Experiment;
+use crate::output::{RunSummary, ERROR_FIELDS, NORMS};
+
+const RATE_COLUMNS: [&str; 10] = [
+    "experiment",
+    "group",
+    "field",
+    "norm",
+    "rate",
+    "intercept",
+    "r2",
+    "n",
+    "h_min",
+    "h_max",
+];
+
+/// One run per row, grouped and coarsest first: identity, matrix values, status, every
+/// final error norm, then the message (last, as it is the field most likely to need quoting).
+pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
+    let mut header: Vec<String> = vec!["run_id".into()];
+    header.extend(experiment.axes.iter().cloned());
+    header.extend(["h", "status", "steps", "dt", "wall_seconds"].map(String::from));
+    header.extend(norm_columns().map(|(field, norm)| format!("{norm}_{field}")));
+    header.push("message".into());
+
+    let rows = ordered_runs(runs).into_iter().map(|run| {
+        let mut row = vec![run.run_id.clone()];
+        row.extend(experiment.axes.iter().map(|axis| {
+            run.axes
+                .get(axis)
+                .map(ToString::to_string)
+                .unwrap_or_default()
+        }));
+        row.extend([
+            exact(run.h),
+            run.status.as_str().to_string(),
+            run.steps.to_string(),
+            exact(run.dt),
+            exact(run.wall_seconds),
+        ]);
+        row.extend(norm_columns().map(|(field, norm)| {
+            run.final_norms
+                .get(&(field.to_string(), norm.to_string()))
+                .map(|&e| exact(e))
+                .unwrap_or_default()
+        }));
+        row.push(run.message.clone());
+        row
+    });
+    csv(&header, rows)
+}
+
+pub fn rates_csv(rates: &[RateRow]) -> String {
+    let rows = rates.iter().map(|r| {
+        vec![
+            r.experiment.clone(),
+            r.group.clone(),
+            r.field.clone(),
+            r.norm.clone(),
+            exact(r.rate),
+            exact(r.intercept),
+            exact(r.r2),
+            r.n.to_string(),
+            exact(r.h_min),
+            exact(r.h_max),
+        ]
+    });
+    csv(&RATE_COLUMNS.map(String::from), rows)
+}
+
+/// (field, norm) pairs, norm-major: all l2 columns, then all rms columns.
+fn norm_columns() -> impl Iterator<Item = (&'static str, &'static str)> {
+    NORMS
+        .into_iter()
+        .flat_map(|norm| ERROR_FIELDS.map(|field| (field, norm)))
+}
+
+fn csv(header: &[String], rows: impl IntoIterator<Item = Vec<String>>) -> String {
+    let mut out = String::new();
+    for row in std::iter::once(header.to_vec()).chain(rows) {
+        let fields: Vec<Cow<str>> = row.iter().map(|f| quote(f)).collect();
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// RFC 4180: a field holding a comma, quote or line break is quoted, inner quotes doubled.
+fn quote(field: &str) -> Cow<'_, str> {
+    if field.contains([',', '"', '\n', '\r']) {
+        Cow::Owned(format!("\"{}\"", field.replace('"', "\"\"")))
+    } else {
+        Cow::Borrowed(field)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quotes_only_when_needed() {
+        assert_eq!(quote("plain"), "plain");
+        assert_eq!(quote("a,b"), "\"a,b\"");
+        assert_eq!(quote("say \"hi\""), "\"say \"\"hi\"\"\"");
+        assert_eq!(quote("two\nlines"), "\"two\nlines\"");
+    }
+
+    #[test]
+    fn rows_join_quoted_fields() {
+        let header = ["a".to_string(), "b".to_string()];
+        let text = csv(&header, [vec!["1".to_string(), "x, y".to_string()]]);
+        assert_eq!(text, "a,b\n1,\"x, y\"\n");
+    }
+}

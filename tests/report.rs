@@ -1,0 +1,369 @@
+//! The report stage end to end on synthetic runs: rates, checks and the files written.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
+
+use mpmlab::experiment::{Expectation, Experiment, FigureKind, FigureSpec, OutputSpec};
+use mpmlab::output::{RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use mpmlab::params::{ParamValue, Params};
+use mpmlab::report::{check, fit_rates, write_report, CheckFailure};
+
+/// Axis values written as in YAML: integers, floats or strings.
+fn params(pairs: &[(&str, &str)]) -> Params {
+    pairs
+        .iter()
+        .map(|&(k, v)| {
+            let value = v
+                .parse::<i64>()
+                .map(ParamValue::Int)
+                .or_else(|_| v.parse::<f64>().map(ParamValue::Float))
+                .unwrap_or_else(|_| ParamValue::Str(v.to_string()));
+            (k.to_string(), value)
+        })
+        .collect()
+}
+
+/// A finished run whose errors follow `C h^p` with `C = G * field_scale * norm_scale`:
+/// p = 2 everywhere except stress with `usl` (p = 1).
+fn run(g: &str, method: &str, cells: usize) -> RunSummary {
+    let h = 1.0 / cells as f64;
+    let c: f64 = g.parse().unwrap();
+    let mut final_norms = BTreeMap::new();
+    for field in ERROR_FIELDS {
+        let p = if field == "stress" && method == "usl" {
+            1
+        } else {
+            2
+        };
+        for norm in NORMS {
+            let error = c * scale(field, norm) * h.powi(p);
+            final_norms.insert((field.to_string(), norm.to_string()), error);
+        }
+    }
+    RunSummary {
+        run_id: format!("{method}-G{g}-c{cells}"),
+        experiment: "gong_conv".into(),
+        benchmark: "mms_gong".into(),
+        method: method.into(),
+        dim: 2,
+        cells,
+        ppc: 2,
+        h,
+        dt: 1e-3 * h,
+        steps: 100 * cells,
+        status: RunStatus::Ok,
+        message: String::new(),
+        wall_seconds: 0.01 * cells as f64,
+        axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
+        final_norms,
+    }
+}
+
+fn scale(field: &str, norm: &str) -> f64 {
+    let field_scale = match field {
+        "displacement" => 0.2,
+        "velocity" => 1.0,
+        "stress" => 5.0,
+        _ => 0.6,
+    };
+    field_scale * if norm == "rms" { 0.5 } else { 1.0 }
+}
+
+/// G x method x cells, with the finest `usl` run at G=0.05 diverged.
+fn runs() -> Vec<RunSummary> {
+    let mut runs = Vec::new();
+    for g in ["0.1", "0.05"] {
+        for method in ["mpm", "usl"] {
+            for cells in [8, 16, 32, 64] {
+                runs.push(run(g, method, cells));
+            }
+        }
+    }
+    let bad = runs
+        .iter_mut()
+        .find(|r| r.run_id == "usl-G0.05-c64")
+        .unwrap();
+    bad.status = RunStatus::Diverged;
+    bad.message = "NaN in stress at step 120, \"J < 0\"".into();
+    for error in bad.final_norms.values_mut() {
+        *error = f64::NAN;
+    }
+    runs
+}
+
+fn experiment(expect: Vec<Expectation>, figures: Vec<FigureSpec>) -> Experiment {
+    Experiment {
+        name: "gong_conv".into(),
+        source_path: "experiments/gong_conv.yaml".into(),
+        source_text: String::new(),
+        benchmark: "mms_gong".into(),
+        axes: ["G", "method", "cells"].map(String::from).to_vec(),
+        output: OutputSpec { every: 10 },
+        expect,
+        figures,
+        runs: Vec::new(),
+    }
+}
+
+fn expect(line: usize, select: &[(&str, &str)], field: &str) -> Expectation {
+    Expectation {
+        select: params(select),
+        field: field.into(),
+        norm: "l2".into(),
+        rate_min: None,
+        rate_max: None,
+        error_max: None,
+        line,
+    }
+}
+
+fn messages(failures: &[CheckFailure]) -> Vec<String> {
+    failures.iter().map(ToString::to_string).collect()
+}
+
+#[test]
+fn rates_are_fitted_per_group_in_order() {
+    let rates = fit_rates(&experiment(vec![], vec![]), &runs());
+    assert_eq!(rates.len(), 4 * ERROR_FIELDS.len() * NORMS.len());
+    let groups: Vec<&str> = rates.iter().map(|r| r.group.as_str()).collect();
+    assert_eq!(groups[0], "G=0.05 method=mpm");
+    assert_eq!(groups[8], "G=0.05 method=usl");
+    assert_eq!(groups[16], "G=0.1 method=mpm");
+    assert_eq!(groups[31], "G=0.1 method=usl");
+    let order: Vec<(&str, &str)> = rates[..8]
+        .iter()
+        .map(|r| (r.field.as_str(), r.norm.as_str()))
+        .collect();
+    assert_eq!(
+        order[..3],
+        [
+            ("displacement", "l2"),
+            ("displacement", "rms"),
+            ("velocity", "l2")
+        ]
+    );
+
+    for r in &rates {
+        let expected = if r.field == "stress" && r.group.ends_with("usl") {
+            1.0
+        } else {
+            2.0
+        };
+        assert!((r.rate - expected).abs() < 1e-10, "{r:?}");
+        assert!((r.r2 - 1.0).abs() < 1e-12, "{r:?}");
+        let c = r.group_axes["G"].as_f64().unwrap() * scale(&r.field, &r.norm);
+        assert!((r.intercept - c.log10()).abs() < 1e-10, "{r:?}");
+    }
+    // The diverged finest run is left out of its group's fits.
+    let usl = rates
+        .iter()
+        .find(|r| r.group == "G=0.05 method=usl")
+        .unwrap();
+    assert_eq!((usl.n, usl.h_min, usl.h_max), (3, 1.0 / 32.0, 0.125));
+    let mpm = &rates[0];
+    assert_eq!((mpm.n, mpm.h_min), (4, 1.0 / 64.0));
+}
+
+#[test]
+fn checks_pass_and_fail_as_stated() {
+    let runs = runs();
+    let mut ok = expect(10, &[("method", "mpm")], "velocity");
+    ok.rate_min = Some(1.8);
+    ok.rate_max = Some(2.2);
+    let mut slow = expect(12, &[("method", "usl"), ("G", "0.1")], "stress");
+    slow.rate_min = Some(1.8);
+    let mut missing = expect(14, &[("method", "mls")], "velocity");
+    missing.rate_min = Some(1.0);
+    let mut fast = expect(16, &[], "density");
+    fast.rate_max = Some(1.5);
+    let exp = experiment(vec![ok, slow, missing, fast], vec![]);
+    let rates = fit_rates(&exp, &runs);
+
+    let failures = messages(&check(&exp, &rates, &runs));
+    assert_eq!(
+        failures,
+        [
+            "line 12: G=0.1 method=usl stress l2: rate 1 < rate_min 1.8",
+            "line 14: no fitted rate for method=mls velocity l2",
+            "line 16: G=0.05 method=mpm density l2: rate 2 > rate_max 1.5",
+            "line 16: G=0.05 method=usl density l2: rate 2 > rate_max 1.5",
+            "line 16: G=0.1 method=mpm density l2: rate 2 > rate_max 1.5",
+            "line 16: G=0.1 method=usl density l2: rate 2 > rate_max 1.5",
+        ]
+    );
+    let exp = experiment(exp.expect[..1].to_vec(), vec![]);
+    assert!(check(&exp, &rates, &runs).is_empty());
+}
+
+#[test]
+fn error_bounds_cover_every_matching_run() {
+    let runs = runs();
+    // 0.1 h^2 <= 2e-3 holds from cells = 8 on; 0.05 h^2 everywhere.
+    let mut loose = expect(20, &[("method", "mpm")], "velocity");
+    loose.error_max = Some(2e-3);
+    let mut tight = expect(21, &[("G", "0.1"), ("method", "mpm")], "velocity");
+    tight.error_max = Some(1e-4);
+    let mut diverged = expect(
+        22,
+        &[("G", "0.05"), ("method", "usl"), ("cells", "64")],
+        "velocity",
+    );
+    diverged.error_max = Some(1.0);
+    let exp = experiment(vec![loose, tight, diverged], vec![]);
+    let rates = fit_rates(&exp, &runs);
+
+    let failures = messages(&check(&exp, &rates, &runs));
+    assert_eq!(
+        failures,
+        [
+            "line 21: G=0.1 cells=8 method=mpm velocity l2: error 0.00156 > error_max 0.0001 (run mpm-G0.1-c8)",
+            "line 21: G=0.1 cells=16 method=mpm velocity l2: error 3.91e-4 > error_max 0.0001 (run mpm-G0.1-c16)",
+            "line 22: G=0.05 cells=64 method=usl velocity l2: run usl-G0.05-c64 diverged: NaN in stress at step 120, \"J < 0\"",
+        ]
+    );
+}
+
+#[test]
+fn report_files_are_written_and_deterministic() {
+    let runs = runs();
+    let mut ok = expect(10, &[("method", "mpm")], "velocity");
+    ok.rate_min = Some(1.8);
+    let mut slow = expect(12, &[("method", "usl")], "stress");
+    slow.rate_min = Some(1.8);
+    let exp = experiment(vec![ok, slow], vec![]);
+    let rates = fit_rates(&exp, &runs);
+    let failures = check(&exp, &rates, &runs);
+
+    let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
+    let reports: Vec<_> = dirs
+        .iter()
+        .map(|d| write_report(d.path(), &exp, &runs, Some(&failures)).unwrap())
+        .collect();
+    let report = &reports[0];
+    assert_eq!(report.rates, rates);
+    assert_eq!(
+        report.figures,
+        [
+            "figures/gong_conv_G_0.05_method_mpm_l2.png",
+            "figures/gong_conv_G_0.05_method_usl_l2.png",
+            "figures/gong_conv_G_0.1_method_mpm_l2.png",
+            "figures/gong_conv_G_0.1_method_usl_l2.png",
+        ]
+        .map(std::path::PathBuf::from)
+    );
+    let dir = dirs[0].path();
+    for figure in &report.figures {
+        let png = fs::read(dir.join(figure)).unwrap();
+        assert!(png.len() > 1000);
+        assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
+        assert_eq!(png, fs::read(dirs[1].path().join(figure)).unwrap());
+    }
+    for name in ["summary.csv", "rates.csv", "report.md"] {
+        assert_eq!(read(dir, name), read(dirs[1].path(), name), "{name}");
+    }
+
+    let summary = read(dir, "summary.csv");
+    let lines: Vec<&str> = summary.lines().collect();
+    assert_eq!(
+        lines[0],
+        "run_id,G,method,cells,h,status,steps,dt,wall_seconds,\
+         l2_displacement,l2_velocity,l2_stress,l2_density,\
+         rms_displacement,rms_velocity,rms_stress,rms_density,message"
+    );
+    assert_eq!(lines.len(), 1 + runs.len());
+    assert!(
+        lines[1].starts_with("mpm-G0.05-c8,0.05,mpm,8,0.125,ok,800,"),
+        "{}",
+        lines[1]
+    );
+    assert!(
+        lines[8].ends_with(",diverged,6400,1.5625e-5,0.64,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,\"NaN in stress at step 120, \"\"J < 0\"\"\""),
+        "{}",
+        lines[8]
+    );
+
+    let rates_csv = read(dir, "rates.csv");
+    let mut rows = rates_csv.lines();
+    assert_eq!(
+        rows.next(),
+        Some("experiment,group,field,norm,rate,intercept,r2,n,h_min,h_max")
+    );
+    assert!(rows
+        .next()
+        .unwrap()
+        .starts_with("gong_conv,G=0.05 method=mpm,displacement,l2,"));
+    assert_eq!(rows.count(), rates.len() - 1);
+
+    let md = read(dir, "report.md");
+    for needle in [
+        "# gong_conv\n",
+        "- Benchmark: `mms_gong`",
+        "- Axis `G`: 0.05, 0.1",
+        "- Runs: 16 (15 ok, 1 diverged, 0 failed)",
+        "| `usl-G0.05-c64` | 0.05 | usl | 64 | 0.015625 | diverged | 6400 |",
+        "| G=0.1 method=usl | stress | l2 | 1.00 | 1.000 | 4 | 0.015625 to 0.125 |",
+        "## Diverged and failed runs",
+        "NaN in stress at step 120, \"J < 0\"",
+        "![gong_conv: G=0.1 method=mpm](figures/gong_conv_G_0.1_method_mpm_l2.png)",
+        "- **pass** line 10: method=mpm velocity l2: rate >= 1.8",
+        "- **FAIL** line 12: method=usl stress l2: rate >= 1.8",
+        "  - G=0.1 method=usl stress l2: rate 1 < rate_min 1.8",
+    ] {
+        assert!(md.contains(needle), "missing {needle:?} in\n{md}");
+    }
+    assert!(!md.contains("wall"));
+}
+
+#[test]
+fn figure_specs_split_by_the_remaining_axes() {
+    let figure = FigureSpec {
+        kind: FigureKind::Convergence,
+        fields: vec!["velocity".into(), "stress".into()],
+        norm: "rms".into(),
+        by: Some("G".into()),
+    };
+    let exp = experiment(vec![], vec![figure.clone(), figure]);
+    let dir = tempfile::tempdir().unwrap();
+    let report = write_report(dir.path(), &exp, &runs(), None).unwrap();
+    let names: Vec<String> = report
+        .figures
+        .iter()
+        .map(|f| f.to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "figures/gong_conv_method_mpm_rms.png",
+            "figures/gong_conv_method_usl_rms.png",
+            "figures/gong_conv_method_mpm_rms_2.png",
+            "figures/gong_conv_method_usl_rms_2.png",
+        ]
+    );
+    assert!(!read(dir.path(), "report.md").contains("## Checks"));
+}
+
+#[test]
+fn a_matrix_over_cells_alone_is_one_group() {
+    let mut exp = experiment(vec![], vec![]);
+    exp.axes = vec!["cells".into()];
+    let runs: Vec<RunSummary> = [8, 16, 32]
+        .map(|cells| {
+            let mut r = run("0.1", "mpm", cells);
+            r.axes = params(&[("cells", &cells.to_string())]);
+            r
+        })
+        .into();
+    let dir = tempfile::tempdir().unwrap();
+    let report = write_report(dir.path(), &exp, &runs, None).unwrap();
+    assert_eq!(
+        report.figures,
+        [std::path::PathBuf::from("figures/gong_conv_all_l2.png")]
+    );
+    assert!(report.rates.iter().all(|r| r.group.is_empty() && r.n == 3));
+    assert!(read(dir.path(), "report.md").contains("| (all) | velocity | l2 | 2.00 |"));
+}
+
+fn read(dir: &Path, name: &str) -> String {
+    fs::read_to_string(dir.join(name)).unwrap()
+}
