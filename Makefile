@@ -1,0 +1,141 @@
+# mpmlab: install, build, test and reproduce every result.
+#
+#   make            (= make all) install what is missing, build, run every experiments/*.yaml
+#                   into results/<name>/ and write its report
+#   make test       lint, unit tests, reduced matrices in tests/matrices/, HDF5 layout test,
+#                   `mpmlab report --check` on each reduced matrix
+#   make bench      particle-steps per second per method and dimension
+#   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
+#   make clean-results   delete generated HDF5 run files (reports and figures stay)
+#
+# Variables: JOBS=N (parallel runs, default: all cores), FORCE=1 (re-run complete runs),
+# RESULTS=DIR (output of `make all`, default results), PYTHON=python3 (to create .venv).
+#
+# Convention: an experiment file's stem equals its `name:` (experiments/foo.yaml has
+# `name: foo`), because its results go to results/<name>/. The recipes check this.
+
+SHELL := bash
+.SHELLFLAGS := -eu -o pipefail -c
+.ONESHELL:
+.DELETE_ON_ERROR:
+.DEFAULT_GOAL := all
+MAKEFLAGS += --no-builtin-rules
+
+# rustup puts cargo in ~/.cargo/bin, which a non-login shell may not have on PATH.
+CARGO_BIN_DIR := $(or $(CARGO_HOME),$(HOME)/.cargo)/bin
+ifneq ($(wildcard $(CARGO_BIN_DIR)/cargo),)
+export PATH := $(CARGO_BIN_DIR):$(PATH)
+endif
+
+CARGO ?= cargo
+PYTHON ?= python3
+RESULTS ?= results
+JOBS ?=
+FORCE ?=
+
+BIN := target/release/mpmlab
+VENV := .venv
+VENV_PY := $(VENV)/bin/python
+PY_REQUIREMENTS := tests/python/requirements.txt
+VENV_STAMP := $(VENV)/.mpmlab-requirements
+TEST_OUT := target/test-matrices
+
+EXPERIMENTS = $(sort $(wildcard experiments/*.yaml))
+MATRICES = $(sort $(wildcard tests/matrices/*.yaml))
+RUN_FLAGS = $(if $(JOBS),--jobs $(JOBS)) $(if $(FORCE),--force)
+
+# die, step, apt_install, check_stems
+SH_LIB := source scripts/lib.sh
+
+.PHONY: all deps deps-system deps-python build lint test bench clean-results
+
+all: deps build
+	@$(SH_LIB)
+	files=($(EXPERIMENTS))
+	[ $${#files[@]} -gt 0 ] || die "no experiments/*.yaml to run"
+	check_stems "$${files[@]}"
+	step "$(BIN) run --out $(RESULTS) $(RUN_FLAGS) $${files[*]}"
+	$(BIN) run --out "$(RESULTS)" $(RUN_FLAGS) "$${files[@]}"
+	for f in "$${files[@]}"; do
+	  name=$$(basename "$$f" .yaml)
+	  step "$(BIN) report $(RESULTS)/$$name"
+	  $(BIN) report "$(RESULTS)/$$name"
+	done
+	echo "reports: $(RESULTS)/*/report.md"
+
+deps: deps-system deps-python
+
+# libhdf5-dev through pkg-config is how the hdf5-metno crate finds HDF5 (on Debian the
+# serial library under /usr/lib/<arch>/hdf5/serial; no HDF5_DIR needed).
+deps-system:
+	@$(SH_LIB)
+	command -v $(CARGO) >/dev/null 2>&1 || die "cargo not found (looked on PATH and in $(CARGO_BIN_DIR)); install a Rust toolchain with rustup"
+	pkgs=()
+	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists hdf5; then
+	  pkgs+=(libhdf5-dev pkg-config)
+	fi
+	command -v cc >/dev/null 2>&1 || pkgs+=(gcc)
+	if [ $${#pkgs[@]} -gt 0 ]; then
+	  apt_install "$${pkgs[@]}"
+	  pkg-config --exists hdf5 || die "pkg-config still does not find hdf5 after installing libhdf5-dev"
+	fi
+
+deps-python: $(VENV_STAMP)
+
+# Re-installed only when the requirements change or the venv is missing.
+$(VENV_STAMP): $(PY_REQUIREMENTS)
+	@$(SH_LIB)
+	if ! "$(VENV_PY)" -m pip --version >/dev/null 2>&1; then
+	  step "$(PYTHON) -m venv $(VENV)"
+	  if ! $(PYTHON) -m venv --clear $(VENV); then
+	    apt_install python3-venv
+	    $(PYTHON) -m venv --clear $(VENV)
+	  fi
+	fi
+	step "pip install -r $(PY_REQUIREMENTS)"
+	"$(VENV_PY)" -m pip install --quiet --disable-pip-version-check -r $(PY_REQUIREMENTS)
+	touch $@
+
+build: deps-system
+	@$(SH_LIB)
+	step "$(CARGO) build --release"
+	$(CARGO) build --release
+
+lint: deps-system
+	@$(SH_LIB)
+	step "$(CARGO) fmt --check"
+	$(CARGO) fmt --check
+	step "$(CARGO) clippy --all-targets --release -- -D warnings"
+	$(CARGO) clippy --all-targets --release -- -D warnings
+
+# The reduced matrices run into a fresh $(TEST_OUT); their files are then checked by the
+# Python layout test and their fitted rates by `mpmlab report --check`.
+test: deps lint build
+	@$(SH_LIB)
+	step "$(CARGO) test --release"
+	$(CARGO) test --release
+	files=($(MATRICES))
+	[ $${#files[@]} -gt 0 ] || die "no tests/matrices/*.yaml: the reduced matrices are part of the test suite"
+	check_stems "$${files[@]}"
+	rm -rf "$(TEST_OUT)"
+	mkdir -p "$(TEST_OUT)"
+	step "$(BIN) run --out $(TEST_OUT) $(RUN_FLAGS) $${files[*]}"
+	$(BIN) run --out "$(TEST_OUT)" $(RUN_FLAGS) "$${files[@]}"
+	step "pytest tests/python (MPMLAB_RESULTS=$(TEST_OUT))"
+	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
+	for f in "$${files[@]}"; do
+	  name=$$(basename "$$f" .yaml)
+	  step "$(BIN) report $(TEST_OUT)/$$name --check"
+	  $(BIN) report "$(TEST_OUT)/$$name" --check
+	done
+
+bench: deps-system
+	@$(SH_LIB)
+	step "$(CARGO) bench --bench throughput"
+	$(CARGO) bench --bench throughput
+
+clean-results:
+	@$(SH_LIB)
+	if [ -d "$(RESULTS)" ]; then
+	  find "$(RESULTS)" -type f \( -name '*.h5' -o -name '*.h5.tmp*' \) -print -delete
+	fi

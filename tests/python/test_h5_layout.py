@@ -1,0 +1,450 @@
+"""Checks the run files under $MPMLAB_RESULTS against the HDF5 layout documented in the
+README ("HDF5 layout", schema_version 1), using h5py and numpy only.
+
+Besides names, types and shapes, it recomputes from the stored arrays:
+  * the quadrature volumes  /errors/volume = volume0 * rho0 / density,
+  * every l2_* and rms_* norm and the final-value attributes of /errors/norms,
+  * the pointwise errors themselves, from /history and an independent implementation of
+    Gong's manufactured solutions (mms1d_gong, mms2d_gong),
+so that the exact solution and the error definitions are checked by a second implementation.
+
+`make test` runs the reduced matrices in tests/matrices/ and points MPMLAB_RESULTS at them.
+Without the variable, or with no *.h5 file under it, the suite fails (it never passes empty).
+"""
+
+import os
+import re
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+ENV = "MPMLAB_RESULTS"
+SCHEMA_VERSION = 1
+
+STR_ATTRS = (
+    "run_id",
+    "experiment",
+    "benchmark",
+    "method",
+    "shape",
+    "transfer",
+    "integrator",
+    "status",
+    "message",
+    "config_yaml",
+    "mpmlab_version",
+)
+INT_ATTRS = ("schema_version", "dim", "cells", "ppc", "steps")
+FLOAT_ATTRS = ("h", "dt", "t_end", "wall_seconds")
+STATUSES = ("ok", "diverged", "failed")
+
+FIELDS = ("displacement", "velocity", "stress", "density")
+NORMS = ("l2", "rms")
+
+# Benchmarks with a known exact solution on the unit interval / square.
+GONG = {"mms1d_gong": 1, "mms2d_gong": 2}
+GONG_PARAMS = ("G", "E", "nu", "rho0", "t_end", "cfl", "ppc", "cells")
+
+RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
+
+# Recomputed quantities agree with the stored ones to this relative tolerance.
+RTOL_STORED = 1e-12
+# Pointwise errors from a second implementation: tolerance relative to the field's scale.
+RTOL_FIELD = 1e-9
+
+
+def _results_root():
+    root = os.environ.get(ENV)
+    return Path(root) if root else None
+
+
+def _find_run_files():
+    root = _results_root()
+    if root is None or not root.is_dir():
+        return []
+    return sorted(root.rglob("*.h5"))
+
+
+RUN_FILES = _find_run_files()
+
+
+def _file_id(path):
+    root = _results_root()
+    try:
+        return str(path.relative_to(root))
+    except ValueError:
+        return str(path)
+
+
+def test_run_files_present():
+    root = _results_root()
+    assert root is not None, (
+        f"{ENV} is not set: point it at a directory of mpmlab results "
+        "(`make test` does this for the reduced matrices in tests/matrices/)"
+    )
+    assert root.is_dir(), f"{ENV}={root} is not a directory"
+    assert RUN_FILES, f"no *.h5 run files under {ENV}={root}"
+
+
+def test_no_leftover_files_in_runs_dirs():
+    """Run files are written under a temporary name and renamed when complete, so a finished
+    `mpmlab run` leaves nothing but <run_id>.h5 in each runs/ directory."""
+    root = _results_root()
+    if root is None or not root.is_dir():
+        pytest.fail(f"{ENV} is not set or not a directory")
+    stray = [
+        str(p)
+        for runs in root.rglob("runs")
+        if runs.is_dir()
+        for p in runs.iterdir()
+        if not (p.is_file() and p.suffix == ".h5")
+    ]
+    assert not stray, f"unexpected entries in runs/ directories: {stray}"
+
+
+# --------------------------------------------------------------------------------------------
+# Loading
+
+
+def _as_str(value):
+    if isinstance(value, bytes):  # fixed-length strings come back as numpy.bytes_
+        return value.decode("utf-8")
+    return value
+
+
+class Run:
+    """Everything in one run file, read into memory once."""
+
+    def __init__(self, path):
+        self.path = path
+        self.attrs = {}
+        self.groups = {}  # "/group" -> its attributes
+        self.data = {}  # "/group/dataset" -> numpy array
+        self.units = {}  # "/group/dataset" -> units attribute (None when missing)
+        with h5py.File(path, "r") as f:
+            self.attrs = {k: _as_str(v) for k, v in f.attrs.items()}
+
+            def visit(name, obj):
+                key = "/" + name
+                if isinstance(obj, h5py.Dataset):
+                    self.data[key] = obj[()]
+                    self.units[key] = _as_str(obj.attrs.get("units"))
+                else:
+                    self.groups[key] = {k: _as_str(v) for k, v in obj.attrs.items()}
+
+            f.visititems(visit)
+
+    def ds(self, name):
+        assert name in self.data, f"missing dataset {name}"
+        return self.data[name]
+
+    def group(self, name):
+        assert name in self.groups, f"missing group {name}"
+        return self.groups[name]
+
+    @property
+    def status(self):
+        return self.attrs.get("status")
+
+    def has_data(self):
+        """A failed run may stop before any state exists; every other run has all datasets."""
+        if self.status == "failed" and "/history/time" not in self.data:
+            return False
+        return True
+
+    def require_data(self):
+        if not self.has_data():
+            pytest.skip("failed run without stored states")
+
+    def param(self, key):
+        params = self.group("/params")
+        assert key in params, f"/params has no attribute {key}"
+        value = params[key]
+        assert np.asarray(value).shape == (), f"/params/{key} is not a scalar"
+        assert isinstance(value, (int, float, np.integer, np.floating)), (
+            f"/params/{key} is not a number: {value!r}"
+        )
+        return float(value)
+
+
+@pytest.fixture(scope="module", params=RUN_FILES, ids=[_file_id(p) for p in RUN_FILES])
+def run(request):
+    return Run(request.param)
+
+
+# --------------------------------------------------------------------------------------------
+# Attributes and identity
+
+
+def test_root_attributes(run):
+    a = run.attrs
+    for name in STR_ATTRS + INT_ATTRS + FLOAT_ATTRS:
+        assert name in a, f"missing root attribute {name}"
+        assert np.asarray(a[name]).shape == (), f"root attribute {name} is not a scalar"
+    for name in STR_ATTRS:
+        assert isinstance(a[name], str), f"{name} is not a string: {a[name]!r}"
+    for name in INT_ATTRS:
+        v = a[name]
+        assert isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)), (
+            f"{name} is not an integer: {v!r} ({type(v).__name__})"
+        )
+    for name in FLOAT_ATTRS:
+        assert isinstance(a[name], (float, np.floating)), (
+            f"{name} is not a float: {a[name]!r} ({type(a[name]).__name__})"
+        )
+        assert np.isfinite(a[name]), f"{name} is not finite: {a[name]}"
+
+    assert a["schema_version"] == SCHEMA_VERSION
+    assert a["status"] in STATUSES, f"status {a['status']!r} not in {STATUSES}"
+    if a["status"] == "diverged":
+        assert a["message"].strip(), "a diverged run must say where and why in `message`"
+    for name in ("run_id", "experiment", "benchmark", "method", "config_yaml", "mpmlab_version"):
+        assert a[name].strip(), f"{name} is empty"
+    assert a["dim"] in (1, 2, 3)
+    assert a["cells"] >= 1 and a["ppc"] >= 1 and a["steps"] >= 0
+    assert a["h"] > 0 and a["dt"] > 0 and a["t_end"] > 0 and a["wall_seconds"] >= 0
+
+
+def test_identity(run):
+    a = run.attrs
+    assert run.path.stem == a["run_id"], "file name must be <run_id>.h5"
+    assert RUN_ID.match(a["run_id"]), (
+        f"run_id {a['run_id']!r} is not <method>-<axis values>-<12 hex digits>"
+    )
+    assert a["run_id"].startswith(a["method"] + "-"), "run_id must start with the method"
+    if run.path.parent.name == "runs":
+        assert run.path.parent.parent.name == a["experiment"], (
+            "run files live in <out>/<experiment>/runs/"
+        )
+    if a["benchmark"] in GONG:
+        assert a["dim"] == GONG[a["benchmark"]], f"{a['benchmark']} has dim {GONG[a['benchmark']]}"
+
+
+def test_params_and_matrix(run):
+    a = run.attrs
+    params = run.group("/params")
+    matrix = run.group("/matrix")
+    assert params, "/params has no attributes"
+    if a["benchmark"] in GONG:
+        for key in GONG_PARAMS:
+            run.param(key)
+        assert run.param("cells") == a["cells"]
+        assert run.param("ppc") == a["ppc"]
+        np.testing.assert_allclose(run.param("t_end"), a["t_end"], rtol=1e-15)
+        np.testing.assert_allclose(a["h"], 1.0 / a["cells"], rtol=RTOL_STORED)
+        c = np.sqrt(run.param("E") / run.param("rho0"))
+        assert a["dt"] <= run.param("cfl") * a["h"] / c * (1 + 1e-12), "dt exceeds cfl h / c"
+    for key, value in matrix.items():
+        assert np.asarray(value).shape == (), f"/matrix/{key} is not a scalar"
+        if key == "method":
+            assert value == a["method"], f"/matrix method {value!r} != root method"
+        else:
+            assert key in params, f"matrix axis {key} is not a parameter in /params"
+            if isinstance(value, str):
+                assert value == params[key], f"/matrix/{key} != /params/{key}"
+            else:
+                np.testing.assert_allclose(
+                    float(value), float(params[key]), rtol=1e-15, err_msg=f"/matrix/{key}"
+                )
+
+
+# --------------------------------------------------------------------------------------------
+# Datasets
+
+
+def _expected_shapes(run):
+    X = run.ds("/particles/X")
+    assert X.ndim == 2, f"/particles/X must be (Np, D), is {X.shape}"
+    n_p, d = X.shape
+    n_t = run.ds("/history/time").shape[0]
+    n_e = run.ds("/errors/time").shape[0]
+    shapes = {
+        "/particles/X": (n_p, d),
+        "/particles/mass": (n_p,),
+        "/particles/volume0": (n_p,),
+        "/history/time": (n_t,),
+        "/history/step": (n_t,),
+        "/history/x": (n_t, n_p, d),
+        "/history/v": (n_t, n_p, d),
+        "/history/stress": (n_t, n_p, d, d),
+        "/history/density": (n_t, n_p),
+        "/errors/time": (n_e,),
+        "/errors/volume": (n_e, n_p),
+    }
+    for field in FIELDS:
+        shapes[f"/errors/{field}"] = (n_e, n_p)
+        for norm in NORMS:
+            shapes[f"/errors/norms/{norm}_{field}"] = (n_e,)
+    return shapes
+
+
+def test_datasets_shapes_types_units(run):
+    run.require_data()
+    a = run.attrs
+    shapes = _expected_shapes(run)
+    d = shapes["/particles/X"][1]
+    assert d == a["dim"], f"/particles/X has {d} columns, dim is {a['dim']}"
+    for name, shape in shapes.items():
+        arr = run.ds(name)
+        assert arr.shape == shape, f"{name} has shape {arr.shape}, expected {shape}"
+        if name == "/history/step":
+            assert np.issubdtype(arr.dtype, np.integer), f"{name} dtype {arr.dtype} is not int"
+        else:
+            assert arr.dtype == np.float64, f"{name} dtype {arr.dtype} is not float64"
+    for name, units in run.units.items():
+        assert isinstance(units, str), f"dataset {name} has no string `units` attribute"
+    n_p = shapes["/particles/X"][0]
+    assert n_p >= 1
+    assert shapes["/history/time"][0] >= 2, "history holds at least t = 0 and the final time"
+    if a["benchmark"] in GONG:
+        assert n_p == (a["cells"] * a["ppc"]) ** a["dim"], "Np != (cells * ppc)^dim"
+
+
+def test_sampling(run):
+    run.require_data()
+    a = run.attrs
+    time = run.ds("/history/time")
+    step = run.ds("/history/step")
+    assert time[0] == 0.0, f"history starts at t = {time[0]}, not 0"
+    assert step[0] == 0
+    assert np.all(np.diff(step) > 0), "history steps are not strictly increasing"
+    assert np.all(np.diff(time) > 0), "history times are not strictly increasing"
+    assert step[-1] == a["steps"], f"last sampled step {step[-1]} != steps {a['steps']}"
+    np.testing.assert_allclose(time, step * a["dt"], rtol=0, atol=1e-6 * a["dt"])
+    gaps = np.diff(step)
+    if gaps.size > 1:
+        assert np.all(gaps[:-1] == gaps[0]), f"uneven sampling interval: {gaps}"
+        assert gaps[-1] <= gaps[0], f"last interval {gaps[-1]} exceeds output.every {gaps[0]}"
+    if a["status"] == "ok":
+        np.testing.assert_allclose(time[-1], a["t_end"], rtol=1e-9, err_msg="final time")
+        np.testing.assert_allclose(a["steps"] * a["dt"], a["t_end"], rtol=1e-12)
+    np.testing.assert_array_equal(
+        run.ds("/errors/time"), time, err_msg="/errors/time differs from /history/time"
+    )
+
+
+def test_particles(run):
+    run.require_data()
+    X = run.ds("/particles/X")
+    mass = run.ds("/particles/mass")
+    vol0 = run.ds("/particles/volume0")
+    assert np.all(mass > 0) and np.all(vol0 > 0)
+    if run.attrs["benchmark"] in GONG:
+        assert np.all((X > 0) & (X < 1)), "reference positions outside the unit domain"
+        np.testing.assert_allclose(mass.sum(), run.param("rho0"), rtol=RTOL_STORED, err_msg="mass")
+        np.testing.assert_allclose(vol0.sum(), 1.0, rtol=RTOL_STORED, err_msg="volume0")
+        # The history starts in the reference configuration.
+        np.testing.assert_array_equal(run.ds("/history/x")[0], X)
+
+
+# --------------------------------------------------------------------------------------------
+# Stored errors against the stored states
+
+
+def test_error_volumes(run):
+    run.require_data()
+    rho0 = run.param("rho0")
+    expected = run.ds("/particles/volume0")[None, :] * rho0 / run.ds("/history/density")
+    np.testing.assert_allclose(
+        run.ds("/errors/volume"), expected, rtol=RTOL_STORED, atol=0, equal_nan=True,
+        err_msg="/errors/volume != volume0 * rho0 / density",
+    )
+
+
+def test_norms(run):
+    run.require_data()
+    volume = run.ds("/errors/volume")
+    n_p = volume.shape[1]
+    final = run.group("/errors/norms")
+    for field in FIELDS:
+        e = run.ds(f"/errors/{field}")
+        finite = np.isfinite(e)
+        assert np.all(e[finite] >= 0), f"/errors/{field} holds negative magnitudes"
+        recomputed = {
+            "l2": np.sqrt(np.sum(volume * e**2, axis=1)),
+            "rms": np.sqrt(np.sum(e**2, axis=1) / n_p),
+        }
+        for norm in NORMS:
+            name = f"{norm}_{field}"
+            stored = run.ds(f"/errors/norms/{name}")
+            np.testing.assert_allclose(
+                stored, recomputed[norm], rtol=RTOL_STORED, atol=0, equal_nan=True,
+                err_msg=f"/errors/norms/{name}",
+            )
+            assert name in final, f"/errors/norms has no attribute {name}"
+            value = final[name]
+            assert np.asarray(value).shape == () and isinstance(value, (float, np.floating)), (
+                f"/errors/norms attribute {name} is not a float scalar"
+            )
+            np.testing.assert_allclose(
+                value, stored[-1], rtol=RTOL_STORED, atol=0, equal_nan=True,
+                err_msg=f"final value attribute {name}",
+            )
+
+
+# --------------------------------------------------------------------------------------------
+# Second implementation of Gong's manufactured solution
+
+
+def gong_exact(X, t, G, E, nu, rho0):
+    """Exact displacement, velocity, Cauchy stress and density of the material points that
+    started at X (Np, D), at times t (Nt,). Returns arrays shaped (Nt, Np, ...).
+
+    U_k = G sin(pi X_k) sin(c pi t), c = sqrt(E / rho0), F = diag(1 + pi G cos(pi X_k) sin(c pi t)),
+    J = prod F_kk, rho = rho0 / J, sigma = (lambda ln J I + mu (F F^T - I)) / J.
+    """
+    c = np.sqrt(E / rho0)
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = E / (2 * (1 + nu))
+    st = np.sin(c * np.pi * t)[:, None, None]
+    ct = np.cos(c * np.pi * t)[:, None, None]
+    sx = np.sin(np.pi * X)[None]
+    cx = np.cos(np.pi * X)[None]
+    u = G * sx * st
+    v = c * np.pi * G * sx * ct
+    f = 1 + np.pi * G * cx * st  # diagonal of F, (Nt, Np, D)
+    j = np.prod(f, axis=-1)
+    d = X.shape[1]
+    sigma = np.zeros(f.shape + (d,))
+    diag = (lam * np.log(j)[..., None] + mu * (f**2 - 1)) / j[..., None]
+    for k in range(d):
+        sigma[..., k, k] = diag[..., k]
+    return u, v, sigma, rho0 / j
+
+
+def _check_pointwise(name, stored, recomputed, numerical, exact):
+    finite = np.isfinite(numerical) & np.isfinite(exact)
+    scale = max(np.max(np.abs(numerical[finite]), initial=0), np.max(np.abs(exact), initial=0))
+    np.testing.assert_allclose(
+        stored, recomputed, rtol=0, atol=RTOL_FIELD * scale + 1e-300, equal_nan=True,
+        err_msg=f"/errors/{name} does not match the independently computed errors",
+    )
+
+
+def test_exact_errors(run):
+    run.require_data()
+    benchmark = run.attrs["benchmark"]
+    if benchmark not in GONG:
+        pytest.skip(f"no independent exact solution for {benchmark}")
+    G, E, nu, rho0 = (run.param(k) for k in ("G", "E", "nu", "rho0"))
+    X = run.ds("/particles/X")
+    t = run.ds("/history/time")
+    u, v, sigma, rho = gong_exact(X, t, G, E, nu, rho0)
+
+    disp = run.ds("/history/x") - X[None]
+    vel = run.ds("/history/v")
+    stress = run.ds("/history/stress")
+    dens = run.ds("/history/density")
+    pairs = {
+        "displacement": (disp, u, np.linalg.norm(disp - u, axis=-1)),
+        "velocity": (vel, v, np.linalg.norm(vel - v, axis=-1)),
+        "stress": (stress, sigma, np.sqrt(np.sum((stress - sigma) ** 2, axis=(-2, -1)))),
+        "density": (dens, rho, np.abs(dens - rho)),
+    }
+    for field, (numerical, exact, recomputed) in pairs.items():
+        _check_pointwise(field, run.ds(f"/errors/{field}"), recomputed, numerical, exact)
+    if run.status == "ok":
+        # At t = 0 the particles sit at X with the exact initial velocity and zero stress.
+        np.testing.assert_array_equal(run.ds("/errors/displacement")[0], 0.0)
