@@ -1,9 +1,65 @@
 //! Experiment files: the YAML schema, validation with file/line/column errors, matrix
 //! expansion and stable run ids. Knows nothing of HDF5 or numerics.
 
-use std::path::PathBuf;
+mod document;
+mod error;
+mod expand;
+mod expect;
+mod figures;
+mod measures;
+mod run_id;
+mod run_spec;
+mod space;
+mod values;
+mod yaml;
+
+use std::path::{Path, PathBuf};
 
 use crate::params::Params;
+
+pub use error::ConfigError;
+pub use expand::MAX_RUNS;
+
+use document::Sections;
+use error::{Pos, FILE_FIELD};
+use space::ParamSpace;
+
+/// Reads and validates an experiment file; an unreadable file is a `ConfigError` too.
+pub fn load(path: &Path) -> Result<Experiment, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        ConfigError::at(Pos::START, FILE_FIELD, format!("cannot read the file: {e}")).in_file(path)
+    })?;
+    parse(&text, path)
+}
+
+/// Validates the text of an experiment file and expands its matrix; `path` names the file in
+/// errors and in `Experiment::source_path`.
+pub fn parse(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
+    build(text, path).map_err(|e| e.in_file(path))
+}
+
+fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
+    let root = yaml::parse_tree(text)?;
+    let sections = Sections::read(&root)?;
+    let name = document::name(&sections)?;
+    let benchmark = document::benchmark(&sections)?;
+    let space = ParamSpace::read(&sections, benchmark.info)?;
+    let output = document::output(&sections)?;
+    let expect = expect::read(sections.get("expect"), &space)?;
+    let figures = figures::read(sections.get("figures"), &space)?;
+    let runs = expand::expand(&name, &benchmark, &space, output.every)?;
+    Ok(Experiment {
+        name,
+        source_path: path.to_path_buf(),
+        source_text: text.to_string(),
+        benchmark: benchmark.info.name.to_string(),
+        axes: space.axes.iter().map(|a| a.key.clone()).collect(),
+        output,
+        expect,
+        figures,
+        runs,
+    })
+}
 
 /// A validated experiment file with its matrix expanded.
 #[derive(Clone, Debug)]

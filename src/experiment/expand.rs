@@ -1,0 +1,284 @@
+//! Matrix expansion: the cartesian product of the axes (last axis fastest), each run resolved
+//! against the benchmark's defaults, checked by the benchmark and given its id.
+
+use crate::benchmarks::ParamDefault;
+use crate::params::{ParamError, ParamValue, Params};
+
+use super::document::Benchmark;
+use super::error::ConfigError;
+use super::run_id::{config_body, config_yaml, run_id};
+use super::space::{ParamSpace, Written};
+use super::values::METHOD_KEY;
+use super::yaml::child_field;
+use super::RunSpec;
+
+/// More runs than this is taken to be a mistake in the matrix, not a plan.
+pub const MAX_RUNS: usize = 100_000;
+
+pub(crate) fn expand(
+    experiment: &str,
+    benchmark: &Benchmark,
+    space: &ParamSpace,
+    output_every: usize,
+) -> Result<Vec<RunSpec>, ConfigError> {
+    let count = run_count(space)?;
+    let defaults = defaults(benchmark);
+    (0..count)
+        .map(|index| {
+            let chosen = choose(space, index);
+            resolve(experiment, benchmark, &defaults, &chosen, output_every)
+        })
+        .collect()
+}
+
+/// The benchmark's parameters that have a default, at their defaults.
+fn defaults(benchmark: &Benchmark) -> Params {
+    let mut defaults = Params::new();
+    for p in benchmark.info.params {
+        let value = match p.default {
+            ParamDefault::Required => continue,
+            ParamDefault::Int(i) => ParamValue::Int(i),
+            ParamDefault::Float(x) => ParamValue::Float(x),
+        };
+        defaults.insert(p.key.to_string(), value);
+    }
+    defaults
+}
+
+fn run_count(space: &ParamSpace) -> Result<usize, ConfigError> {
+    space
+        .axes
+        .iter()
+        .try_fold(1usize, |n, axis| n.checked_mul(axis.values.len()))
+        .filter(|&n| n <= MAX_RUNS)
+        .ok_or_else(|| {
+            let sizes: Vec<String> = space
+                .axes
+                .iter()
+                .map(|a| a.values.len().to_string())
+                .collect();
+            ConfigError::at(
+                space.matrix_pos,
+                "matrix",
+                format!(
+                    "the matrix ({} values per axis) expands to more than {MAX_RUNS} runs",
+                    sizes.join(" x ")
+                ),
+            )
+        })
+}
+
+/// A value a run takes from the file.
+struct Chosen<'a> {
+    key: &'a str,
+    written: &'a Written,
+    /// From a matrix axis rather than from params.
+    is_axis: bool,
+}
+
+/// The values of run number `index`: the fixed ones, then one per axis in file order.
+fn choose(space: &ParamSpace, index: usize) -> Vec<Chosen<'_>> {
+    let mut from_axes = Vec::with_capacity(space.axes.len());
+    let mut rest = index;
+    for axis in space.axes.iter().rev() {
+        from_axes.push(Chosen {
+            key: &axis.key,
+            written: &axis.values[rest % axis.values.len()],
+            is_axis: true,
+        });
+        rest /= axis.values.len();
+    }
+    from_axes.reverse();
+    let fixed = space.fixed.iter().map(|(key, written)| Chosen {
+        key,
+        written,
+        is_axis: false,
+    });
+    fixed.chain(from_axes).collect()
+}
+
+/// Builds one run from its chosen values and the defaults.
+fn resolve(
+    experiment: &str,
+    benchmark: &Benchmark,
+    defaults: &Params,
+    chosen: &[Chosen],
+    output_every: usize,
+) -> Result<RunSpec, ConfigError> {
+    let mut params = defaults.clone();
+    let mut method = String::new();
+    let mut axes = Params::new();
+    let mut id_axes = Vec::new();
+    for c in chosen {
+        let value = &c.written.value;
+        if c.key == METHOD_KEY {
+            method = value.to_string();
+        } else {
+            params.insert(c.key.to_string(), value.clone());
+            if c.is_axis {
+                id_axes.push((c.key, value));
+            }
+        }
+        if c.is_axis {
+            axes.insert(c.key.to_string(), value.clone());
+        }
+    }
+    (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
+    let body = config_body(benchmark.info.name, &method, output_every, &params);
+    Ok(RunSpec {
+        experiment: experiment.to_string(),
+        run_id: run_id(&method, &id_axes, &body),
+        benchmark: benchmark.info.name.to_string(),
+        method,
+        params,
+        axes,
+        output_every,
+        config_yaml: config_yaml(experiment, &body),
+    })
+}
+
+/// Places a failed benchmark check at the value it names: the matrix element or params entry
+/// it came from, or the benchmark key for a default; and says which run it was.
+fn check_error(
+    error: ParamError,
+    benchmark: &Benchmark,
+    params: &Params,
+    chosen: &[Chosen],
+) -> ConfigError {
+    let run: Vec<String> = chosen
+        .iter()
+        .filter(|c| c.is_axis)
+        .map(|c| format!("{}={}", c.key, c.written.value))
+        .collect();
+    let in_run = if run.is_empty() {
+        String::new()
+    } else {
+        format!(" (in the run with {})", run.join(", "))
+    };
+    match chosen.iter().find(|c| c.key == error.key) {
+        Some(Chosen { written, .. }) => ConfigError::at(
+            written.pos,
+            written.field.as_str(),
+            format!("{}{in_run}", error.message),
+        ),
+        None => {
+            let default = params
+                .get(&error.key)
+                .map_or_else(String::new, |v| format!(" = {v}"));
+            ConfigError::at(
+                benchmark.pos,
+                child_field("params", &error.key),
+                format!(
+                    "the default {}{default} of {}: {}{in_run}",
+                    error.key, benchmark.info.name, error.message
+                ),
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::benchmarks::{BenchmarkInfo, ParamKind, ParamSpec};
+    use crate::experiment::error::Pos;
+    use crate::experiment::space::Axis;
+    use crate::experiment::values::ValueKind;
+
+    /// A benchmark whose check rejects its own default, which no real benchmark does.
+    const TOY: BenchmarkInfo = BenchmarkInfo {
+        name: "toy",
+        dim: 1,
+        source: "",
+        description: "",
+        params: &[
+            ParamSpec {
+                key: "k",
+                kind: ParamKind::PositiveInt,
+                default: ParamDefault::Int(3),
+                unit: "1",
+                doc: "",
+            },
+            ParamSpec {
+                key: "x",
+                kind: ParamKind::Real,
+                default: ParamDefault::Required,
+                unit: "1",
+                doc: "",
+            },
+        ],
+        check: reject_three,
+    };
+
+    fn reject_three(params: &Params) -> Result<(), ParamError> {
+        match params.get("k") {
+            Some(ParamValue::Int(3)) => Err(ParamError::new("k", "3 is not allowed")),
+            _ => Ok(()),
+        }
+    }
+
+    fn written(value: ParamValue, line: usize, field: &str) -> Written {
+        Written {
+            value,
+            pos: Pos { line, column: 5 },
+            field: field.to_string(),
+        }
+    }
+
+    fn toy_space() -> ParamSpace {
+        let xs = [1.0, 2.0].map(ParamValue::Float);
+        ParamSpace {
+            fixed: vec![(
+                METHOD_KEY.to_string(),
+                written(ParamValue::Str("mpm".into()), 3, "params.method"),
+            )],
+            axes: vec![Axis {
+                key: "x".into(),
+                kind: ValueKind::Param(ParamKind::Real),
+                values: xs
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, v)| written(v, 5, &format!("matrix.x[{i}]")))
+                    .collect(),
+            }],
+            matrix_pos: Pos { line: 4, column: 1 },
+        }
+    }
+
+    #[test]
+    fn a_rejected_default_points_at_the_benchmark() {
+        let benchmark = Benchmark {
+            info: &TOY,
+            pos: Pos {
+                line: 2,
+                column: 12,
+            },
+        };
+        let e = expand("toy_exp", &benchmark, &toy_space(), 0).unwrap_err();
+        assert_eq!((e.line, e.column, e.field.as_str()), (2, 12, "params.k"));
+        assert!(e.message.contains("the default k = 3 of toy"), "{e}");
+        assert!(e.message.ends_with("(in the run with x=1.0)"), "{e}");
+    }
+
+    #[test]
+    fn runs_take_defaults_and_axis_values() {
+        let benchmark = Benchmark {
+            info: &TOY,
+            pos: Pos::START,
+        };
+        let mut space = toy_space();
+        space
+            .fixed
+            .push(("k".into(), written(ParamValue::Int(4), 3, "params.k")));
+        let runs = expand("toy_exp", &benchmark, &space, 7).unwrap();
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[1].params["x"], ParamValue::Float(2.0));
+        assert_eq!(runs[1].params["k"], ParamValue::Int(4));
+        assert_eq!(runs[1].output_every, 7);
+        assert!(
+            runs[1].run_id.starts_with("mpm-x2.0-"),
+            "{}",
+            runs[1].run_id
+        );
+    }
+}

@@ -1,0 +1,186 @@
+//! Scalar values: the kind each settable key takes, and the normalisation of what the file
+//! wrote into the canonical `ParamValue` that run ids hash (`G: 1` and `G: 1.0` are one run).
+
+use crate::benchmarks::{BenchmarkInfo, ParamKind};
+use crate::methods;
+use crate::params::ParamValue;
+
+use super::error::ConfigError;
+use super::yaml::{child_field, Entry, Node, NodeKind};
+
+/// The key that selects the method; settable like a benchmark parameter.
+pub(crate) const METHOD_KEY: &str = "method";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ValueKind {
+    Param(ParamKind),
+    Method,
+}
+
+/// The kind of a key of `params` or `matrix`: a parameter of the benchmark or the method.
+/// Any other key is an error listing the valid ones.
+pub(crate) fn settable_kind(
+    info: &BenchmarkInfo,
+    entry: &Entry,
+    parent: &str,
+) -> Result<ValueKind, ConfigError> {
+    if entry.key == METHOD_KEY {
+        return Ok(ValueKind::Method);
+    }
+    match info.params.iter().find(|p| p.key == entry.key) {
+        Some(p) => Ok(ValueKind::Param(p.kind)),
+        None => {
+            let valid = info.params.iter().map(|p| p.key).chain([METHOD_KEY]);
+            Err(ConfigError::at(
+                entry.key_pos,
+                child_field(parent, entry.key),
+                format!("unknown parameter '{}' for {}", entry.key, info.name),
+            )
+            .with_valid(valid))
+        }
+    }
+}
+
+pub(crate) fn normalize(
+    kind: ValueKind,
+    node: &Node,
+    field: &str,
+) -> Result<ParamValue, ConfigError> {
+    match kind {
+        ValueKind::Method => {
+            choice(node, field, "method", &methods::preset_names()).map(ParamValue::Str)
+        }
+        ValueKind::Param(ParamKind::Real) => finite(node, field).map(ParamValue::Float),
+        ValueKind::Param(ParamKind::PositiveReal) => positive(node, field).map(ParamValue::Float),
+        ValueKind::Param(ParamKind::PositiveInt) => positive_int(node, field).map(ParamValue::Int),
+    }
+}
+
+/// A finite number, integer or not.
+pub(crate) fn finite(node: &Node, field: &str) -> Result<f64, ConfigError> {
+    real_where(node, field, "a finite number", |_| true)
+}
+
+/// A finite number > 0.
+pub(crate) fn positive(node: &Node, field: &str) -> Result<f64, ConfigError> {
+    real_where(node, field, "a finite number > 0", |x| x > 0.0)
+}
+
+fn real_where(
+    node: &Node,
+    field: &str,
+    expected: &str,
+    accept: impl Fn(f64) -> bool,
+) -> Result<f64, ConfigError> {
+    let value = match node.kind {
+        NodeKind::Int(i) => Some(i as f64),
+        NodeKind::Float(x) if x.is_finite() => Some(x),
+        _ => None,
+    };
+    match value {
+        // Adding 0.0 turns -0.0 into 0.0, so both spellings give the same run.
+        Some(x) if accept(x) => Ok(x + 0.0),
+        _ => Err(node.expected(field, expected)),
+    }
+}
+
+/// An integer >= 1; `8.0` is rejected too, since a count written as a real is likely a slip.
+pub(crate) fn positive_int(node: &Node, field: &str) -> Result<i64, ConfigError> {
+    match node.kind {
+        NodeKind::Int(i) if i >= 1 => i64::try_from(i)
+            .map_err(|_| node.expected(field, "an integer >= 1 that fits in 64 bits")),
+        _ => Err(node.expected(field, "an integer >= 1")),
+    }
+}
+
+/// Text that must be one of `valid`; `what` names the thing chosen, for the message.
+pub(crate) fn choice(
+    node: &Node,
+    field: &str,
+    what: &str,
+    valid: &[&str],
+) -> Result<String, ConfigError> {
+    pick(node, field, what, valid, |v| v).map(|v| v.to_string())
+}
+
+/// The option whose name the node's text is.
+pub(crate) fn pick<'o, T>(
+    node: &Node,
+    field: &str,
+    what: &str,
+    options: &'o [T],
+    name: impl Fn(&T) -> &str,
+) -> Result<&'o T, ConfigError> {
+    let names = || options.iter().map(&name).collect::<Vec<_>>();
+    let text = node.as_text(field).map_err(|e| e.with_valid(names()))?;
+    options.iter().find(|o| name(o) == text).ok_or_else(|| {
+        ConfigError::at(node.pos, field, format!("unknown {what} '{text}'")).with_valid(names())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::yaml::parse_tree;
+
+    /// The value of `v: ...` as a node.
+    fn node(yaml_value: &str) -> Node {
+        let tree = parse_tree(&format!("v: {yaml_value}")).unwrap();
+        let entries = tree.entries("").unwrap();
+        entries[0].value.clone()
+    }
+
+    fn norm(kind: ParamKind, yaml_value: &str) -> Result<ParamValue, ConfigError> {
+        normalize(ValueKind::Param(kind), &node(yaml_value), "params.v")
+    }
+
+    #[test]
+    fn reals_normalise_to_floats() {
+        assert_eq!(norm(ParamKind::Real, "1"), Ok(ParamValue::Float(1.0)));
+        assert_eq!(norm(ParamKind::Real, "1.0"), Ok(ParamValue::Float(1.0)));
+        assert_eq!(norm(ParamKind::Real, "-0.0").unwrap().to_string(), "0.0");
+        assert_eq!(
+            norm(ParamKind::PositiveReal, "1.0e7"),
+            Ok(ParamValue::Float(1e7))
+        );
+        for bad in [
+            ".nan", ".inf", "-.inf", "1e999", "'1.0'", "[1]", "true", "~",
+        ] {
+            let e = norm(ParamKind::Real, bad).unwrap_err();
+            assert!(e.message.contains("expected a finite number"), "{bad}: {e}");
+            assert_eq!((e.line, e.column), (1, 4));
+        }
+        for bad in ["0", "-2.5", "0.0"] {
+            let e = norm(ParamKind::PositiveReal, bad).unwrap_err();
+            assert!(e.message.contains("> 0"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn counts_must_be_integers_of_at_least_one() {
+        assert_eq!(norm(ParamKind::PositiveInt, "8"), Ok(ParamValue::Int(8)));
+        for bad in [
+            "8.5",
+            "8.0",
+            "0",
+            "-3",
+            "'8'",
+            "1e3",
+            "18446744073709551615",
+        ] {
+            let e = norm(ParamKind::PositiveInt, bad).unwrap_err();
+            assert!(e.message.contains("expected an integer"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn methods_are_checked_against_the_presets() {
+        let ok = normalize(ValueKind::Method, &node("mpm"), "params.method");
+        assert_eq!(ok, Ok(ParamValue::Str("mpm".into())));
+        let e = normalize(ValueKind::Method, &node("flip"), "params.method").unwrap_err();
+        assert!(e.message.contains("unknown method 'flip'"));
+        assert!(e.valid.contains(&"mpm".to_string()));
+        let e = normalize(ValueKind::Method, &node("3"), "params.method").unwrap_err();
+        assert!(e.valid.contains(&"mpm".to_string()), "{e}");
+    }
+}

@@ -1,0 +1,707 @@
+//! Experiment files: every bad input gives one located error (file, line, column, field, and
+//! the valid choices where there are any), a valid file expands into stable run ids, and no
+//! input at all makes the parser panic.
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use mpmlab::experiment::{self, ConfigError, Experiment, FigureKind, MAX_RUNS};
+use mpmlab::params::ParamValue;
+
+const FILE: &str = "exp.yaml";
+
+const VALID: &str = "\
+name: gong_mpm_1d
+benchmark: mms1d_gong
+params: {E: 1.0e7, nu: 0.3, rho0: 1000.0, t_end: 0.02, cfl: 0.4, ppc: 2, method: mpm}
+matrix:
+  G: [1.0e-4, 0.1]
+  cells: [8, 16, 32, 64, 128]
+output: {every: 10}
+expect:
+  - {G: 1.0e-4, field: velocity, norm: l2, rate_min: 1.8}
+  - {G: 0.1, field: stress, rate_max: 1.0}
+figures:
+  - {kind: convergence, fields: [stress, density, velocity, displacement], by: G}
+";
+
+fn parse(text: &str) -> Result<Experiment, ConfigError> {
+    experiment::parse(text, Path::new(FILE))
+}
+
+fn error(text: &str) -> ConfigError {
+    match parse(text) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+/// The valid file with its first `from` replaced by `to`.
+fn edited(from: &str, to: &str) -> String {
+    let text = VALID.replacen(from, to, 1);
+    assert_ne!(text, VALID, "'{from}' is not in the valid file");
+    text
+}
+
+/// Checks where the error is, what it names and that it mentions `message`; `valid` must all
+/// be among the listed choices (and show in the one-line display).
+fn check(e: &ConfigError, line: usize, column: usize, field: &str, message: &str, valid: &[&str]) {
+    let shown = e.to_string();
+    assert_eq!(
+        (e.line, e.column, e.field.as_str()),
+        (line, column, field),
+        "{shown}"
+    );
+    assert!(e.message.contains(message), "'{message}' not in: {shown}");
+    assert!(
+        shown.starts_with(&format!("{FILE}:{line}:{column}: field '{field}': ")),
+        "{shown}"
+    );
+    for choice in valid {
+        assert!(
+            e.valid.iter().any(|v| v == choice),
+            "{choice} not listed: {shown}"
+        );
+    }
+    if !valid.is_empty() {
+        assert!(
+            shown.ends_with(&format!("(valid: {})", e.valid.join(", "))),
+            "{shown}"
+        );
+    }
+}
+
+#[test]
+fn unknown_method_lists_the_presets() {
+    let e = error(&edited("method: mpm", "method: flip"));
+    check(
+        &e,
+        3,
+        82,
+        "params.method",
+        "unknown method 'flip'",
+        &["mpm"],
+    );
+    let text = edited("ppc: 2, method: mpm}", "ppc: 2}")
+        .replace("matrix:\n", "matrix:\n  method: [mpm, flip]\n");
+    let e = error(&text);
+    check(&e, 5, 17, "matrix.method[1]", "unknown method", &["mpm"]);
+}
+
+#[test]
+fn missing_method_lists_the_presets() {
+    let e = error(&edited(", method: mpm}", "}"));
+    check(&e, 3, 1, "params.method", "required", &["mpm"]);
+}
+
+#[test]
+fn unknown_benchmark_lists_the_catalogue() {
+    let e = error(&edited("benchmark: mms1d_gong", "benchmark: mms3d"));
+    check(
+        &e,
+        2,
+        12,
+        "benchmark",
+        "unknown benchmark 'mms3d'",
+        &["mms1d_gong", "mms2d_gong"],
+    );
+}
+
+#[test]
+fn unknown_top_level_key_lists_the_sections() {
+    let e = error(&edited("output:", "outputs:"));
+    let sections = [
+        "name",
+        "benchmark",
+        "params",
+        "matrix",
+        "output",
+        "expect",
+        "figures",
+    ];
+    check(&e, 7, 1, "outputs", "unknown key 'outputs'", &sections);
+}
+
+#[test]
+fn unknown_parameter_lists_the_benchmark_parameters() {
+    let e = error(&edited("nu: 0.3", "poisson: 0.3"));
+    check(
+        &e,
+        3,
+        20,
+        "params.poisson",
+        "unknown parameter 'poisson'",
+        &["nu", "cfl", "method"],
+    );
+    let e = error(&edited("  G: [", "  g: ["));
+    check(
+        &e,
+        5,
+        3,
+        "matrix.g",
+        "unknown parameter 'g'",
+        &["G", "cells"],
+    );
+}
+
+#[test]
+fn wrong_types_name_the_expected_type() {
+    let e = error(&edited("E: 1.0e7", "E: stiff"));
+    check(
+        &e,
+        3,
+        13,
+        "params.E",
+        "expected a finite number > 0, found the text 'stiff'",
+        &[],
+    );
+    let e = error(&edited("ppc: 2", "ppc: '2'"));
+    check(&e, 3, 71, "params.ppc", "expected an integer", &[]);
+    let e = error(&edited("G: [1.0e-4, 0.1]", "G: 0.1"));
+    check(
+        &e,
+        5,
+        6,
+        "matrix.G",
+        "expected a list, found the number 0.1",
+        &[],
+    );
+    let e = error(&edited("params: {", "params: [{").replace("method: mpm}", "method: mpm}]"));
+    check(&e, 3, 9, "params", "expected a map, found a list", &[]);
+    let e = error(&edited("t_end: 0.02", "t_end: .inf"));
+    check(&e, 3, 50, "params.t_end", "expected a finite number", &[]);
+}
+
+#[test]
+fn cells_and_ppc_must_be_positive_integers() {
+    for (bad, found) in [("0", "0"), ("-16", "-16"), ("16.0", "16.0"), ("8.5", "8.5")] {
+        let e = error(&edited("cells: [8, 16,", &format!("cells: [8, {bad},")));
+        check(
+            &e,
+            6,
+            14,
+            "matrix.cells[1]",
+            "expected an integer >= 1",
+            &[],
+        );
+        assert!(e.message.contains(found), "{e}");
+    }
+    for bad in ["0", "-1", "2.0"] {
+        let e = error(&edited("ppc: 2", &format!("ppc: {bad}")));
+        check(&e, 3, 71, "params.ppc", "expected an integer >= 1", &[]);
+    }
+}
+
+#[test]
+fn matrix_values_in_block_lists_are_located() {
+    let e = error(&edited(
+        "  cells: [8, 16, 32, 64, 128]",
+        "  cells:\n    - 8\n    - 0",
+    ));
+    check(&e, 8, 7, "matrix.cells[1]", "expected an integer >= 1", &[]);
+}
+
+#[test]
+fn unstable_cfl_is_reported_at_its_value_with_the_run() {
+    let e = error(&edited("cfl: 0.4", "cfl: 0.95"));
+    check(&e, 3, 61, "params.cfl", "unstable", &[]);
+    assert!(e.message.contains("G=0.0001, cells=8"), "{e}");
+    let text = edited("cfl: 0.4, ", "").replace("  cells:", "  cfl: [0.4, 0.95]\n  cells:");
+    let e = error(&text);
+    check(&e, 6, 14, "matrix.cfl[1]", "unstable", &[]);
+    assert!(e.message.contains("cfl=0.95"), "{e}");
+}
+
+#[test]
+fn missing_required_parameter_is_named() {
+    let e = error(&edited("ppc: 2, ", ""));
+    check(&e, 3, 1, "params.ppc", "'ppc' is required", &[]);
+    let text = "name: x\nbenchmark: mms1d_gong\nmatrix: {method: [mpm], G: [0.1], cells: [8]}\n";
+    check(&error(text), 1, 1, "params.ppc", "'ppc' is required", &[]);
+}
+
+#[test]
+fn a_key_in_params_and_matrix_is_rejected() {
+    let e = error(&edited("cfl: 0.4", "cfl: 0.4, G: 0.1"));
+    check(&e, 5, 3, "matrix.G", "also set in params (line 3)", &[]);
+}
+
+#[test]
+fn expect_selector_must_be_a_value_of_its_axis() {
+    let e = error(&edited("{G: 0.1, field", "{G: 0.2, field"));
+    check(
+        &e,
+        10,
+        9,
+        "expect[1].G",
+        "no run has G = 0.2",
+        &["0.0001", "0.1"],
+    );
+    let e = error(&edited("{G: 0.1, field", "{cells: 8, field"));
+    check(
+        &e,
+        10,
+        6,
+        "expect[1].cells",
+        "refinement axis",
+        &["field", "rate_min", "G"],
+    );
+    let e = error(&edited("{G: 0.1, field", "{E: 1.0e7, field"));
+    check(&e, 10, 6, "expect[1].E", "unknown key 'E'", &["field", "G"]);
+}
+
+#[test]
+fn expect_entries_need_a_field_and_a_bound() {
+    let e = error(&edited("field: stress, ", ""));
+    check(
+        &e,
+        10,
+        5,
+        "expect[1].field",
+        "missing",
+        &["stress", "velocity"],
+    );
+    let e = error(&edited("field: stress", "field: strain"));
+    check(
+        &e,
+        10,
+        21,
+        "expect[1].field",
+        "unknown field 'strain'",
+        &["stress"],
+    );
+    let e = error(&edited(", rate_max: 1.0}", "}"));
+    check(
+        &e,
+        10,
+        5,
+        "expect[1]",
+        "at least one bound",
+        &["rate_min", "error_max"],
+    );
+    let e = error(&edited("norm: l2", "norm: max"));
+    check(
+        &e,
+        9,
+        40,
+        "expect[0].norm",
+        "unknown norm 'max'",
+        &["l2", "rms"],
+    );
+    let e = error(&edited("rate_min: 1.8", "rate_min: fast"));
+    check(
+        &e,
+        9,
+        54,
+        "expect[0].rate_min",
+        "expected a finite number",
+        &[],
+    );
+}
+
+#[test]
+fn figure_by_must_be_a_matrix_axis() {
+    let e = error(&edited("by: G", "by: E"));
+    check(
+        &e,
+        12,
+        80,
+        "figures[0].by",
+        "'E' is not a matrix axis",
+        &["G"],
+    );
+    let e = error(&edited("by: G", "by: cells"));
+    check(&e, 12, 80, "figures[0].by", "refinement axis", &["G"]);
+    let e = error(&edited("kind: convergence", "kind: histogram"));
+    check(
+        &e,
+        12,
+        12,
+        "figures[0].kind",
+        "unknown figure kind",
+        &["convergence"],
+    );
+    let e = error(&edited("fields: [stress,", "fields: [strain,"));
+    check(
+        &e,
+        12,
+        34,
+        "figures[0].fields[0]",
+        "unknown field",
+        &["stress"],
+    );
+    let e = error(&edited(", by: G}", ", colour: red}"));
+    check(
+        &e,
+        12,
+        76,
+        "figures[0].colour",
+        "unknown key",
+        &["kind", "fields", "norm", "by"],
+    );
+}
+
+#[test]
+fn output_interval_must_be_positive() {
+    for bad in ["0", "-5"] {
+        let e = error(&edited("every: 10", &format!("every: {bad}")));
+        check(&e, 7, 17, "output.every", "omit 'every'", &[]);
+    }
+    let e = error(&edited("every: 10", "every: 2.5"));
+    check(&e, 7, 17, "output.every", "expected an integer", &[]);
+    let e = error(&edited("every: 10", "evry: 10"));
+    check(&e, 7, 10, "output.evry", "unknown key", &["every"]);
+}
+
+#[test]
+fn names_must_be_directory_names() {
+    let e = error(&edited("name: gong_mpm_1d", "name: gong/mpm 1d"));
+    check(&e, 1, 7, "name", "directory name", &[]);
+    let e = error(&edited("name: gong_mpm_1d\n", ""));
+    check(&e, 1, 1, "name", "missing required key 'name'", &[]);
+}
+
+#[test]
+fn axes_need_distinct_values() {
+    let e = error(&edited("G: [1.0e-4, 0.1]", "G: [0.1, 1.0e-1]"));
+    check(
+        &e,
+        5,
+        12,
+        "matrix.G[1]",
+        "repeats the value of matrix.G[0]",
+        &[],
+    );
+    let e = error(&edited("G: [1.0e-4, 0.1]", "G: []"));
+    check(&e, 5, 6, "matrix.G", "at least one value", &[]);
+}
+
+#[test]
+fn absurd_matrices_are_refused() {
+    let values: Vec<String> = (1..=400).map(|i| i.to_string()).collect();
+    let axis = format!("[{}]", values.join(", "));
+    let text = format!(
+        "name: big\nbenchmark: mms1d_gong\nparams: {{G: 0.1, method: mpm}}\n\
+         matrix:\n  ppc: {axis}\n  cells: {axis}\n"
+    );
+    let e = error(&text);
+    check(
+        &e,
+        4,
+        1,
+        "matrix",
+        &format!("more than {MAX_RUNS} runs"),
+        &[],
+    );
+    assert!(e.message.contains("400 x 400"), "{e}");
+}
+
+#[test]
+fn yaml_syntax_errors_are_located() {
+    let e = error(&edited("cells: [8, 16, 32, 64, 128]", "cells: [8, 16}"));
+    check(&e, 6, 10, "cells", "invalid YAML: mismatched bracket", &[]);
+    let e = error(&edited(
+        "output: {every: 10}",
+        "output: {every: 10, every: 20}",
+    ));
+    check(&e, 7, 21, "every", "duplicate key 'every'", &[]);
+    let e = error(&edited(
+        "name: gong_mpm_1d",
+        "name: gong_mpm_1d\nname: again",
+    ));
+    check(&e, 2, 1, "name", "duplicate key 'name'", &[]);
+}
+
+#[test]
+fn unreadable_files_are_config_errors() {
+    let path = Path::new("/nonexistent/experiment.yaml");
+    let e = experiment::load(path).unwrap_err();
+    assert_eq!((e.file.as_path(), e.line, e.column), (path, 1, 1));
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/experiment.yaml:1:1: field "),
+        "{e}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gong.yaml");
+    std::fs::write(&path, VALID).unwrap();
+    let exp = experiment::load(&path).unwrap();
+    assert_eq!(
+        (exp.source_path.as_path(), exp.source_text.as_str()),
+        (path.as_path(), VALID)
+    );
+}
+
+#[test]
+fn valid_file_expands_in_order_with_stable_ids() {
+    let exp = parse(VALID).unwrap();
+    assert_eq!(exp.name, "gong_mpm_1d");
+    assert_eq!(exp.benchmark, "mms1d_gong");
+    assert_eq!(exp.axes, ["G", "cells"]);
+    assert_eq!(exp.output.every, 10);
+    assert_eq!(exp.runs.len(), 10);
+    let order: Vec<(String, String)> = exp
+        .runs
+        .iter()
+        .map(|r| (r.axes["G"].to_string(), r.axes["cells"].to_string()))
+        .collect();
+    let expected: Vec<(String, String)> = ["0.0001", "0.1"]
+        .iter()
+        .flat_map(|g| ["8", "16", "32", "64", "128"].map(|c| (g.to_string(), c.to_string())))
+        .collect();
+    assert_eq!(order, expected, "last axis varies fastest");
+
+    let run = &exp.runs[0];
+    assert_eq!((run.method.as_str(), run.output_every), ("mpm", 10));
+    assert_eq!(run.params["G"], ParamValue::Float(1e-4));
+    assert_eq!(run.params["cells"], ParamValue::Int(8));
+    assert!(!run.params.contains_key("method"));
+    assert!(run
+        .config_yaml
+        .starts_with("experiment: gong_mpm_1d\nbenchmark: mms1d_gong\n"));
+    let (prefix, hash) = run.run_id.rsplit_once('-').unwrap();
+    assert_eq!(prefix, "mpm-G0.0001-cells8");
+    assert!(
+        hash.len() == 12 && hash.chars().all(|c| c.is_ascii_hexdigit()),
+        "{hash}"
+    );
+    let unique: HashSet<&str> = exp.runs.iter().map(|r| r.run_id.as_str()).collect();
+    assert_eq!(unique.len(), exp.runs.len());
+
+    assert_eq!(exp.expect.len(), 2);
+    assert_eq!(exp.expect[0].select["G"], ParamValue::Float(1e-4));
+    assert_eq!((exp.expect[0].line, exp.expect[0].rate_min), (9, Some(1.8)));
+    assert_eq!(
+        (exp.expect[1].norm.as_str(), exp.expect[1].rate_max),
+        ("l2", Some(1.0))
+    );
+    assert_eq!(exp.figures[0].kind, FigureKind::Convergence);
+    assert_eq!(exp.figures[0].fields[0], "stress");
+    assert_eq!(exp.figures[0].by.as_deref(), Some("G"));
+}
+
+#[test]
+fn defaults_fill_what_the_file_leaves_out() {
+    let text = "name: x\nbenchmark: mms2d_gong\nparams: {G: 0.1, ppc: 2, cells: 4}\n\
+                matrix: {method: [mpm]}\nfigures: [{kind: convergence}]\n";
+    let exp = parse(text).unwrap();
+    let run = &exp.runs[0];
+    for (key, value) in [
+        ("E", 1e7),
+        ("nu", 0.3),
+        ("rho0", 1e3),
+        ("t_end", 0.02),
+        ("cfl", 0.4),
+    ] {
+        assert_eq!(run.params[key], ParamValue::Float(value), "{key}");
+    }
+    assert_eq!(exp.output.every, 0);
+    assert_eq!(run.axes["method"], ParamValue::Str("mpm".into()));
+    assert_eq!(run.run_id.matches("mpm").count(), 1, "{}", run.run_id);
+    assert_eq!(
+        exp.figures[0].fields,
+        ["displacement", "velocity", "stress", "density"]
+    );
+    assert_eq!(
+        (exp.figures[0].norm.as_str(), exp.figures[0].by.as_deref()),
+        ("l2", None)
+    );
+}
+
+fn ids(text: &str) -> Vec<String> {
+    parse(text)
+        .unwrap()
+        .runs
+        .into_iter()
+        .map(|r| r.run_id)
+        .collect()
+}
+
+#[test]
+fn run_ids_follow_the_resolved_configuration_only() {
+    let base = ids(VALID);
+    assert_eq!(ids(VALID), base, "stable across parses");
+    assert_eq!(
+        ids(&edited("name: gong_mpm_1d", "name: renamed")),
+        base,
+        "name is not hashed"
+    );
+    assert_eq!(
+        ids(&edited("E: 1.0e7", "E: 10000000")),
+        base,
+        "1e7 and 10000000 are one value"
+    );
+    assert_eq!(ids(&edited("figures:\n", "figures: \n")), base);
+    let changed = ids(&edited("cfl: 0.4", "cfl: 0.3"));
+    assert!(base.iter().zip(&changed).all(|(a, b)| a != b));
+    let changed = ids(&edited("every: 10", "every: 5"));
+    assert!(base.iter().zip(&changed).all(|(a, b)| a != b));
+}
+
+#[test]
+fn runs_describe_themselves() {
+    let exp = parse(VALID).unwrap();
+    let run = &exp.runs[5];
+    assert_eq!(
+        run.describe(),
+        format!("{}  mms1d_gong mpm G=0.1 cells=8", run.run_id)
+    );
+    let json = run.to_json();
+    assert_eq!(json["run_id"], run.run_id.as_str());
+    assert_eq!(json["params"]["cells"], 8);
+    assert_eq!(json["axes"]["G"], 0.1);
+    assert_eq!(json["output_every"], 10);
+}
+
+/// A small deterministic generator, so that a failure can be replayed.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+/// Whole documents that are odd in one way each.
+const ODD_DOCUMENTS: &[&str] = &[
+    "",
+    "\n\n",
+    "---\n",
+    "~",
+    "- a\n- b\n",
+    "[1, 2]",
+    "42",
+    "just text",
+    "\u{feff}name: x\n",
+    "name:\n\tx\n",
+    "\tname: x\n",
+    "name: x\r\nbenchmark: mms1d_gong\r\n",
+    "name: x\nname: y\n",
+    "? [a, b]\n: c\n",
+    "name: &a x\nbenchmark: *a\n",
+    "name: *missing\n",
+    "a: &a [*a]\n",
+    "--- a\n--- b\n",
+    "%YAML 9.9\n---\nname: x\n",
+    "name: !!binary aGVsbG8=\n",
+    "name: !custom x\nbenchmark: !!int mms\n",
+    "name: \"\\q\"\n",
+    "name: 'unterminated\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 1e999, ppc: 99999999999999999999999, method: mpm, cells: .nan}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: -.inf, ppc: -9223372036854775808, method: mpm, cells: 18446744073709551615}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: mpm, cells: 9223372036854775807}\n",
+    "name: ünïcødé\nbenchmark: mms1d_gong\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, método: mpm}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: 🦀, cells: 8}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {<<: {G: 0.1, ppc: 1}, method: mpm, cells: 8}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: mpm, cells: 8}\nmatrix: {}\nexpect: []\nfigures: []\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: mpm, cells: 8}\nexpect: [1, [], {}, {field: velocity, rate_min: 1, method: mpm}]\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: mpm, cells: 8}\nfigures: [{kind: convergence, fields: []}]\n",
+    "name: x\nbenchmark: mms1d_gong\nparams: {G: 0.1, ppc: 1, method: mpm, cells: 8}\noutput: {every: 99999999999999999999}\n",
+    "name: x\nbenchmark: mms1d_gong\nparams:\nmatrix:\noutput:\nexpect:\nfigures:\n",
+];
+
+/// Values dropped in place of the valid file's scalars: every wrong type and edge case.
+const ODD_VALUES: &[&str] = &[
+    "~",
+    "true",
+    "0",
+    "-1",
+    "8.0",
+    "1e999",
+    ".nan",
+    "99999999999999999999",
+    "[]",
+    "{a: 1}",
+    "'8'",
+    "ünï",
+    "\"\\u0000\"",
+    "cells",
+];
+
+/// Characters that matter to YAML, spliced in at random.
+const ODD_CHARS: &[&str] = &[
+    ":", "{", "}", "[", "]", ",", "-", "#", "&a", "*a", "!", "|", ">", "'", "\"", "%", "@", "\t",
+    "\n", " ", "?", "é", "\u{0}", "\r", "9", ".",
+];
+
+fn assert_no_panic_and_located(text: &str) {
+    let result = std::panic::catch_unwind(|| parse(text));
+    let Ok(result) = result else {
+        panic!("parser panicked on {text:?}");
+    };
+    if let Err(e) = result {
+        assert!(
+            e.line >= 1 && e.column >= 1,
+            "unlocated error {e} for {text:?}"
+        );
+        assert!(
+            !e.field.is_empty() && !e.message.is_empty(),
+            "{e} for {text:?}"
+        );
+        assert!(!e.to_string().contains('\n'), "multi-line error {e:?}");
+    }
+}
+
+#[test]
+fn odd_documents_never_panic_and_errors_are_located() {
+    for text in ODD_DOCUMENTS {
+        assert_no_panic_and_located(text);
+    }
+}
+
+#[test]
+fn every_scalar_replaced_by_odd_values_never_panics() {
+    let starts = VALID.char_indices().filter(|&(i, c)| {
+        let prev = VALID[..i].chars().last();
+        c.is_alphanumeric() && matches!(prev, Some(' ' | '[' | '{'))
+    });
+    for (start, _) in starts {
+        let end = VALID[start..]
+            .find([',', '}', ']', '\n'])
+            .map_or(VALID.len(), |n| start + n);
+        for value in ODD_VALUES {
+            assert_no_panic_and_located(&format!("{}{value}{}", &VALID[..start], &VALID[end..]));
+        }
+    }
+}
+
+#[test]
+fn random_splices_cuts_and_swaps_never_panic() {
+    let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+    for _ in 0..600 {
+        let mut text: Vec<char> = VALID.chars().collect();
+        for _ in 0..1 + rng.below(3) {
+            let at = rng.below(text.len() + 1);
+            match rng.below(3) {
+                0 => {
+                    let odd = ODD_CHARS[rng.below(ODD_CHARS.len())];
+                    text.splice(at..at, odd.chars());
+                }
+                1 => {
+                    let to = (at + rng.below(8)).min(text.len());
+                    text.drain(at..to);
+                }
+                _ => {
+                    let joined: String = text.iter().collect();
+                    let mut lines: Vec<&str> = joined.lines().collect();
+                    let n = lines.len().max(1);
+                    let (a, b) = (rng.below(n), rng.below(n));
+                    if b < lines.len() {
+                        lines.swap(a.min(b), b);
+                    }
+                    text = lines.join("\n").chars().collect();
+                }
+            }
+        }
+        assert_no_panic_and_located(&text.iter().collect::<String>());
+    }
+}
