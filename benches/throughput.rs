@@ -16,13 +16,28 @@ struct Case {
 }
 
 const CASES: &[Case] = &[
-    Case { benchmark: "mms1d_gong", cells: 1024, ppc: 4 },
-    Case { benchmark: "mms2d_gong", cells: 128, ppc: 2 },
+    Case {
+        benchmark: "mms1d_gong",
+        cells: 1024,
+        ppc: 4,
+    },
+    Case {
+        benchmark: "mms2d_gong",
+        cells: 128,
+        ppc: 2,
+    },
 ];
 
 fn spec(case: &Case, method: &str) -> RunSpec {
     let mut params = Params::new();
-    for (key, value) in [("G", 0.05), ("E", 1e7), ("nu", 0.3), ("rho0", 1e3), ("t_end", 0.02), ("cfl", 0.4)] {
+    for (key, value) in [
+        ("G", 0.05),
+        ("E", 1e7),
+        ("nu", 0.3),
+        ("rho0", 1e3),
+        ("t_end", 0.02),
+        ("cfl", 0.4),
+    ] {
         params.insert(key.into(), ParamValue::Float(value));
     }
     params.insert("cells".into(), ParamValue::Int(case.cells));
@@ -42,7 +57,10 @@ fn spec(case: &Case, method: &str) -> RunSpec {
 fn main() {
     // Bench harnesses are passed flags such as --bench; a bare word filters by method.
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    println!("{:<8} {:<12} {:>10} {:>8} {:>10} {:>14}", "method", "benchmark", "particles", "steps", "seconds", "Mparticle-steps/s");
+    println!(
+        "{:<8} {:<12} {:>10} {:>8} {:>10} {:>14}",
+        "method", "benchmark", "particles", "steps", "seconds", "Mparticle-steps/s"
+    );
     for preset in methods::presets() {
         if filter.as_deref().is_some_and(|f| f != preset.name) {
             continue;
@@ -60,7 +78,13 @@ fn main() {
             }
             let record = record.expect("three runs were made");
             if record.status != RunStatus::Ok {
-                println!("{:<8} {:<12} {}: {}", preset.name, case.benchmark, record.status.as_str(), record.message);
+                println!(
+                    "{:<8} {:<12} {}: {}",
+                    preset.name,
+                    case.benchmark,
+                    record.status.as_str(),
+                    record.message
+                );
                 continue;
             }
             let particles = record.particles.len();

@@ -5,6 +5,7 @@
 //! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`.
 
 pub mod benchmarks;
+pub mod collect;
 
 pub mod experiment;
 pub mod integrate;

@@ -92,7 +92,9 @@ fn estimated_cost(run: &RunSpec) -> usize {
     let dim = crate::benchmarks::info(&run.benchmark).map_or(1, |b| b.dim) as u32;
     let cells = get_usize(&run.params, "cells").unwrap_or(1);
     let ppc = get_usize(&run.params, "ppc").unwrap_or(1);
-    cells.saturating_pow(dim + 1).saturating_mul(ppc.saturating_pow(dim))
+    cells
+        .saturating_pow(dim + 1)
+        .saturating_mul(ppc.saturating_pow(dim))
 }
 
 fn write_experiment_copy(dir: &Path, text: &str) -> io::Result<()> {
@@ -107,9 +109,11 @@ fn progress_bar(name: &str, len: usize) -> ProgressBar {
         return ProgressBar::with_draw_target(Some(len as u64), ProgressDrawTarget::hidden());
     }
     let bar = ProgressBar::new(len as u64);
-    let style = ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} runs {elapsed_precise} eta {eta}")
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> ");
+    let style = ProgressStyle::with_template(
+        "{prefix} [{bar:40}] {pos}/{len} runs {elapsed_precise} eta {eta}",
+    )
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .progress_chars("=> ");
     bar.set_style(style);
     bar.set_prefix(name.to_string());
     bar

@@ -282,7 +282,14 @@ mod tests {
 
     fn params(g: f64, cells: i64) -> Params {
         let mut p = Params::new();
-        for (k, v) in [("G", g), ("E", 1e7), ("nu", 0.3), ("rho0", 1e3), ("t_end", 0.02), ("cfl", 0.4)] {
+        for (k, v) in [
+            ("G", g),
+            ("E", 1e7),
+            ("nu", 0.3),
+            ("rho0", 1e3),
+            ("t_end", 0.02),
+            ("cfl", 0.4),
+        ] {
             p.insert(k.into(), ParamValue::Float(v));
         }
         p.insert("ppc".into(), ParamValue::Int(2));

@@ -43,14 +43,20 @@ mod tests {
 
     #[test]
     fn stress_free_at_identity() {
-        let m = NeoHookean { lambda: 5.0, mu: 3.0 };
+        let m = NeoHookean {
+            lambda: 5.0,
+            mu: 3.0,
+        };
         let s = m.cauchy(&M2::identity(), 1.0);
         assert_eq!(s, M2::zeros());
     }
 
     #[test]
     fn matches_formula_for_general_gradient() {
-        let m = NeoHookean { lambda: 5.0, mu: 3.0 };
+        let m = NeoHookean {
+            lambda: 5.0,
+            mu: 3.0,
+        };
         let f = M2::new(1.1, 0.2, -0.1, 0.9);
         let j = f.determinant();
         let expected = (M2::identity() * (m.lambda * j.ln())

@@ -16,7 +16,11 @@ pub fn write_run(results: &Path, record: &RunRecord) -> io::Result<PathBuf> {
     let path = run_path(results, &record.spec.run_id);
     let dir = path.parent().unwrap_or(Path::new("."));
     fs::create_dir_all(dir)?;
-    let tmp = dir.join(format!(".{}.h5.tmp-{}", record.spec.run_id, std::process::id()));
+    let tmp = dir.join(format!(
+        ".{}.h5.tmp-{}",
+        record.spec.run_id,
+        std::process::id()
+    ));
     if tmp.exists() {
         fs::remove_file(&tmp)?;
     }

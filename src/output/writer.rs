@@ -30,7 +30,12 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     ] {
         attr_str(&file, name, value)?;
     }
-    for (name, value) in [("dim", d), ("cells", r.cells), ("ppc", r.ppc), ("steps", r.steps)] {
+    for (name, value) in [
+        ("dim", d),
+        ("cells", r.cells),
+        ("ppc", r.ppc),
+        ("steps", r.steps),
+    ] {
         attr_i64(&file, name, value as i64)?;
     }
     for (name, value) in [
@@ -59,7 +64,10 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     let history = file.create_group("history")?;
     dataset(&history, "time", &r.history.time, &[nt], "s")?;
     let steps = ArrayView::from_shape(IxDyn(&[nt]), &r.history.step).map_err(shape_error)?;
-    let ds = history.new_dataset_builder().with_data(steps).create("step")?;
+    let ds = history
+        .new_dataset_builder()
+        .with_data(steps)
+        .create("step")?;
     attr_str(&ds, "units", "1")?;
     dataset(&history, "x", &r.history.x, &[nt, np, d], "m")?;
     dataset(&history, "v", &r.history.v, &[nt, np, d], "m/s")?;
@@ -96,7 +104,13 @@ fn shape_error(e: ndarray::ShapeError) -> hdf5::Error {
     hdf5::Error::from(format!("array shape: {e}"))
 }
 
-fn dataset(group: &Group, name: &str, data: &[f64], shape: &[usize], unit: &str) -> hdf5::Result<()> {
+fn dataset(
+    group: &Group,
+    name: &str,
+    data: &[f64],
+    shape: &[usize],
+    unit: &str,
+) -> hdf5::Result<()> {
     let view = ArrayView::from_shape(IxDyn(shape), data).map_err(shape_error)?;
     let ds = group.new_dataset_builder().with_data(view).create(name)?;
     attr_str(&ds, "units", unit)
@@ -121,9 +135,15 @@ fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
 }
 
 fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {
-    loc.new_attr::<f64>().shape(()).create(name)?.write_scalar(&value)
+    loc.new_attr::<f64>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&value)
 }
 
 fn attr_i64(loc: &Location, name: &str, value: i64) -> hdf5::Result<()> {
-    loc.new_attr::<i64>().shape(()).create(name)?.write_scalar(&value)
+    loc.new_attr::<i64>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&value)
 }

@@ -39,7 +39,14 @@ mod tests {
 
     fn problem<const D: usize>() -> GongMms<D> {
         let mut p = Params::new();
-        for (k, v) in [("G", 0.1), ("E", 1e7), ("nu", 0.3), ("rho0", 1e3), ("t_end", 0.02), ("cfl", 0.4)] {
+        for (k, v) in [
+            ("G", 0.1),
+            ("E", 1e7),
+            ("nu", 0.3),
+            ("rho0", 1e3),
+            ("t_end", 0.02),
+            ("cfl", 0.4),
+        ] {
             p.insert(k.into(), ParamValue::Float(v));
         }
         p.insert("ppc".into(), ParamValue::Int(3));
@@ -55,7 +62,9 @@ mod tests {
         let mut particles = Particles::seed(&prob, &grid);
         let mut state = 12345u64;
         let mut rand = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for p in 0..particles.len() {
@@ -72,8 +81,12 @@ mod tests {
         particles_to_grid(&st, &particles, &body, &mut nodes);
 
         let total_mass: f64 = particles.mass.iter().sum();
-        let momentum: SVector<f64, D> = (0..particles.len()).map(|p| particles.v[p] * particles.mass[p]).sum();
-        let external: SVector<f64, D> = (0..particles.len()).map(|p| body[p] * particles.mass[p]).sum();
+        let momentum: SVector<f64, D> = (0..particles.len())
+            .map(|p| particles.v[p] * particles.mass[p])
+            .sum();
+        let external: SVector<f64, D> = (0..particles.len())
+            .map(|p| body[p] * particles.mass[p])
+            .sum();
         let grid_mass: f64 = nodes.mass.iter().sum();
         let grid_momentum: SVector<f64, D> = nodes.momentum.iter().sum();
         let grid_force: SVector<f64, D> = nodes.force.iter().sum();

@@ -31,7 +31,11 @@ impl<const D: usize> Shape<D> for LinearHat {
             let mut g = SVector::<f64, D>::repeat(inv_h);
             for k in 0..D {
                 let upper = corner >> k & 1 == 1;
-                let (wk, dk) = if upper { (xi[k], 1.0) } else { (1.0 - xi[k], -1.0) };
+                let (wk, dk) = if upper {
+                    (xi[k], 1.0)
+                } else {
+                    (1.0 - xi[k], -1.0)
+                };
                 if upper {
                     index += grid.stride(k);
                 }

@@ -76,7 +76,9 @@ mod tests {
         (0..n)
             .map(|_| {
                 SVector::from_fn(|_, _| {
-                    state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
                     -0.5 + 2.0 * ((state >> 11) as f64 / (1u64 << 53) as f64)
                 })
             })
@@ -128,7 +130,10 @@ mod tests {
         let value = |y: &SVector<f64, 2>, node: usize| {
             let mut st = Stencils::new(4, 1);
             st.update(&LinearHat, &g, std::slice::from_ref(y)).unwrap();
-            let w = st.of(0).find(|(i, _, _)| *i == node).map_or(0.0, |(_, w, _)| w);
+            let w = st
+                .of(0)
+                .find(|(i, _, _)| *i == node)
+                .map_or(0.0, |(_, w, _)| w);
             w
         };
         let mut st = Stencils::new(4, 1);
@@ -141,7 +146,11 @@ mod tests {
                 xp[k] += eps;
                 xm[k] -= eps;
                 let fd = (value(&xp, i) - value(&xm, i)) / (2.0 * eps);
-                assert!((fd - grad[k]).abs() < 1e-8, "node {i} axis {k}: {fd} vs {}", grad[k]);
+                assert!(
+                    (fd - grad[k]).abs() < 1e-8,
+                    "node {i} axis {k}: {fd} vs {}",
+                    grad[k]
+                );
             }
         }
     }
@@ -149,7 +158,10 @@ mod tests {
     #[test]
     fn outside_points_are_reported() {
         let g = grid::<2>(4);
-        let xs = vec![SVector::<f64, 2>::new(0.0, 0.0), SVector::<f64, 2>::new(1.6, 0.0)];
+        let xs = vec![
+            SVector::<f64, 2>::new(0.0, 0.0),
+            SVector::<f64, 2>::new(1.6, 0.0),
+        ];
         let mut st = Stencils::new(4, 2);
         assert_eq!(st.update(&LinearHat, &g, &xs), Err(1));
         let nan = vec![SVector::<f64, 2>::new(f64::NAN, 0.0)];

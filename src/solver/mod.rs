@@ -96,7 +96,10 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
             Ok(()) => (RunStatus::Ok, String::new()),
             Err((step, reason)) => (
                 RunStatus::Diverged,
-                format!("step {step} (t = {:e}): {reason}", step as f64 * self.problem.dt()),
+                format!(
+                    "step {step} (t = {:e}): {reason}",
+                    step as f64 * self.problem.dt()
+                ),
             ),
         };
         self.into_record(steps, status, message)
@@ -111,13 +114,21 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         let material = self.problem.material();
         let particle_mass = self.particles.mass.iter().cloned().fold(0.0, f64::max);
         let mut synced = vec![SVector::zeros(); self.particles.len()];
-        if let Err(p) = self.stencils.update(&self.shape, &self.grid, &self.particles.x) {
+        if let Err(p) = self
+            .stencils
+            .update(&self.shape, &self.grid, &self.particles.x)
+        {
             return (0, Err((0, Divergence::LeftGrid { particle: p })));
         }
         for s in 0..=steps {
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
-            particles_to_grid(&self.stencils, &self.particles, &self.body_force, &mut self.nodes);
+            particles_to_grid(
+                &self.stencils,
+                &self.particles,
+                &self.body_force,
+                &mut self.nodes,
+            );
             let kick = if s == 0 { 0.5 * dt } else { dt };
             leapfrog::solve_grid(&mut self.nodes, &self.fixed, kick, particle_mass);
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
@@ -146,7 +157,10 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
             if let Err(reason) = updated {
                 return (s, Err((s + 1, reason)));
             }
-            if let Err(p) = self.stencils.update(&self.shape, &self.grid, &self.particles.x) {
+            if let Err(p) = self
+                .stencils
+                .update(&self.shape, &self.grid, &self.particles.x)
+            {
                 return (s, Err((s + 1, Divergence::LeftGrid { particle: p })));
             }
         }
@@ -163,7 +177,12 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         record.steps = steps;
         record.status = status;
         record.particles = ParticleTable {
-            x0: self.particles.x0.iter().flat_map(|x| x.iter().copied()).collect(),
+            x0: self
+                .particles
+                .x0
+                .iter()
+                .flat_map(|x| x.iter().copied())
+                .collect(),
             mass: self.particles.mass,
             volume0: self.particles.volume0,
         };
