@@ -141,10 +141,22 @@ pub struct GongMms<const D: usize> {
     ppc: usize,
     dt: f64,
     steps: usize,
-    /// sin(pi X_k) and cos(pi X_k) of every particle, so the body force costs one log per
-    /// particle and step.
-    sin_x: Vec<SVector<f64, D>>,
-    cos_x: Vec<SVector<f64, D>>,
+    /// The body force of particle p depends on each X_k separately, and particles seeded on
+    /// a lattice share few distinct X_k: per axis, the time-dependent factors are computed
+    /// once per distinct coordinate and step, and particles look them up.
+    axes: [AxisTable; D],
+    /// Per particle, the index of its X_k in `axes[k]`.
+    axis_index: Vec<[u32; D]>,
+}
+
+/// Distinct reference coordinates along one axis and the factors of the body force there.
+#[derive(Clone, Debug, Default)]
+struct AxisTable {
+    sin: Vec<f64>,
+    cos: Vec<f64>,
+    /// Refilled every step: ln F_kk and 1/F_kk^2.
+    ln_f: Vec<f64>,
+    inv_f2: Vec<f64>,
 }
 
 impl<const D: usize> GongMms<D> {
@@ -170,8 +182,8 @@ impl<const D: usize> GongMms<D> {
             ppc: get_usize(params, "ppc")?,
             dt,
             steps,
-            sin_x: Vec::new(),
-            cos_x: Vec::new(),
+            axes: std::array::from_fn(|_| AxisTable::default()),
+            axis_index: Vec::new(),
         })
     }
 
@@ -240,23 +252,50 @@ impl<const D: usize> Problem<D> for GongMms<D> {
     }
 
     fn attach_particles(&mut self, x0: &[SVector<f64, D>]) {
-        self.sin_x = x0.iter().map(|x| x.map(|xk| (PI * xk).sin())).collect();
-        self.cos_x = x0.iter().map(|x| x.map(|xk| (PI * xk).cos())).collect();
+        for k in 0..D {
+            let mut coords: Vec<f64> = x0.iter().map(|x| x[k]).collect();
+            coords.sort_by(f64::total_cmp);
+            coords.dedup();
+            for (p, x) in x0.iter().enumerate() {
+                if k == 0 {
+                    self.axis_index.push([0; D]);
+                }
+                let j = coords.partition_point(|&c| c < x[k]);
+                self.axis_index[p][k] = j as u32;
+            }
+            let n = coords.len();
+            self.axes[k] = AxisTable {
+                sin: coords.iter().map(|&c| (PI * c).sin()).collect(),
+                cos: coords.iter().map(|&c| (PI * c).cos()).collect(),
+                ln_f: vec![0.0; n],
+                inv_f2: vec![0.0; n],
+            };
+        }
     }
 
     /// Gong eq 4.46 (eq 4.39 for D = 1) with E read as rho0 c^2:
-    /// B_k = (pi^2 U_k / rho0) [lambda (1 - ln J)/F_kk^2 + mu (1 + 1/F_kk^2) - rho0 c^2].
-    fn body_force(&self, t: f64, out: &mut [SVector<f64, D>]) {
+    /// B_k = (pi^2 U_k / rho0) [lambda (1 - ln J)/F_kk^2 + mu (1 + 1/F_kk^2) - rho0 c^2],
+    /// with ln J = sum_k ln F_kk.
+    fn body_force(&mut self, t: f64, out: &mut [SVector<f64, D>]) {
         let st = (self.c * PI * t).sin();
         let (lambda, mu) = (self.material.lambda, self.material.mu);
         let amp = PI * PI * self.g * st / self.rho0;
         let gpi = PI * self.g * st;
-        for ((b, s), c) in out.iter_mut().zip(&self.sin_x).zip(&self.cos_x) {
-            let f = c.map(|ck| 1.0 + gpi * ck);
-            let ln_j = f.iter().product::<f64>().ln();
+        for axis in &mut self.axes {
+            for j in 0..axis.cos.len() {
+                let f = 1.0 + gpi * axis.cos[j];
+                axis.ln_f[j] = f.ln();
+                axis.inv_f2[j] = 1.0 / (f * f);
+            }
+        }
+        for (b, index) in out.iter_mut().zip(&self.axis_index) {
+            let ln_j: f64 = (0..D).map(|k| self.axes[k].ln_f[index[k] as usize]).sum();
             for k in 0..D {
-                let inv_f2 = 1.0 / (f[k] * f[k]);
-                b[k] = amp * s[k] * (lambda * (1.0 - ln_j) * inv_f2 + mu * (1.0 + inv_f2) - self.e);
+                let j = index[k] as usize;
+                let inv_f2 = self.axes[k].inv_f2[j];
+                b[k] = amp
+                    * self.axes[k].sin[j]
+                    * (lambda * (1.0 - ln_j) * inv_f2 + mu * (1.0 + inv_f2) - self.e);
             }
         }
     }

@@ -97,7 +97,7 @@ pub trait Problem<const D: usize>: Send + Sync {
     fn initial_velocity(&self, x0: &SVector<f64, D>) -> SVector<f64, D>;
     /// Body force per unit mass at every particle at time `t`, written into `out`.
     /// Called once per step, so implementations precompute what does not depend on time.
-    fn body_force(&self, t: f64, out: &mut [SVector<f64, D>]);
+    fn body_force(&mut self, t: f64, out: &mut [SVector<f64, D>]);
     /// Prepare `body_force` for these reference positions (called once before stepping).
     fn attach_particles(&mut self, x0: &[SVector<f64, D>]);
     fn exact(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>>;
