@@ -3,10 +3,11 @@
 
 use std::time::Instant;
 
+use mpmlab::benchmarks::thesis_params;
 use mpmlab::experiment::RunSpec;
 use mpmlab::methods;
 use mpmlab::output::RunStatus;
-use mpmlab::params::{ParamValue, Params};
+use mpmlab::params::Params;
 use mpmlab::solver::simulate;
 
 struct Case {
@@ -29,19 +30,7 @@ const CASES: &[Case] = &[
 ];
 
 fn spec(case: &Case, method: &str) -> RunSpec {
-    let mut params = Params::new();
-    for (key, value) in [
-        ("G", 0.05),
-        ("E", 1e7),
-        ("nu", 0.3),
-        ("rho0", 1e3),
-        ("t_end", 0.02),
-        ("cfl", 0.4),
-    ] {
-        params.insert(key.into(), ParamValue::Float(value));
-    }
-    params.insert("cells".into(), ParamValue::Int(case.cells));
-    params.insert("ppc".into(), ParamValue::Int(case.ppc));
+    let params = thesis_params(0.05, case.cells, case.ppc);
     RunSpec {
         experiment: "bench".into(),
         run_id: "bench".into(),

@@ -19,3 +19,5 @@ pub mod report;
 pub mod runner;
 pub mod shape;
 pub mod solver;
+#[cfg(test)]
+mod testing;

@@ -130,6 +130,25 @@ fn check_params(params: &Params) -> Result<(), ParamError> {
     Ok(())
 }
 
+/// Gong's parameter set of sec 4.6 (E = 1e7, nu = 0.3, rho0 = 1e3, t_end = 0.02, cfl = 0.4)
+/// with the given amplitude, cells and points per cell.
+pub fn thesis_params(g: f64, cells: i64, ppc: i64) -> Params {
+    let mut p = Params::new();
+    for (k, v) in [
+        ("G", g),
+        ("E", 1e7),
+        ("nu", 0.3),
+        ("rho0", 1e3),
+        ("t_end", 0.02),
+        ("cfl", 0.4),
+    ] {
+        p.insert(k.into(), crate::params::ParamValue::Float(v));
+    }
+    p.insert("ppc".into(), crate::params::ParamValue::Int(ppc));
+    p.insert("cells".into(), crate::params::ParamValue::Int(cells));
+    p
+}
+
 /// The manufactured problem in `D` dimensions.
 pub struct GongMms<const D: usize> {
     g: f64,
@@ -319,23 +338,6 @@ mod tests {
     use super::*;
     use crate::params::ParamValue;
 
-    fn params(g: f64, cells: i64) -> Params {
-        let mut p = Params::new();
-        for (k, v) in [
-            ("G", g),
-            ("E", 1e7),
-            ("nu", 0.3),
-            ("rho0", 1e3),
-            ("t_end", 0.02),
-            ("cfl", 0.4),
-        ] {
-            p.insert(k.into(), ParamValue::Float(v));
-        }
-        p.insert("ppc".into(), ParamValue::Int(2));
-        p.insert("cells".into(), ParamValue::Int(cells));
-        p
-    }
-
     /// First Piola stress P_kk of the exact solution, for the finite-difference check.
     fn piola<const D: usize>(m: &GongMms<D>, x0: &SVector<f64, D>, t: f64) -> SVector<f64, D> {
         let (_, f) = m.kinematics(x0, t);
@@ -346,7 +348,7 @@ mod tests {
     /// rho0 B must equal rho0 A - Div P, with A and Div P by central differences of the
     /// manufactured displacement and stress.
     fn check_body_force<const D: usize>() {
-        let mut m = GongMms::<D>::from_params(&params(0.1, 16)).unwrap();
+        let mut m = GongMms::<D>::from_params(&thesis_params(0.1, 16, 2)).unwrap();
         let points: Vec<SVector<f64, D>> = [0.13, 0.37, 0.71, 0.94]
             .iter()
             .map(|&a| SVector::from_fn(|k, _| (a + 0.21 * k as f64) % 1.0))
@@ -389,14 +391,14 @@ mod tests {
 
     #[test]
     fn thesis_time_step_divides_one_period() {
-        let m = GongMms::<1>::from_params(&params(1e-4, 8)).unwrap();
+        let m = GongMms::<1>::from_params(&thesis_params(1e-4, 8, 2)).unwrap();
         assert_eq!(m.steps, 40);
         assert!((m.dt - 5e-4).abs() < 1e-18);
     }
 
     #[test]
     fn exact_state_is_consistent() {
-        let m = GongMms::<2>::from_params(&params(0.05, 8)).unwrap();
+        let m = GongMms::<2>::from_params(&thesis_params(0.05, 8, 2)).unwrap();
         let x0 = SVector::<f64, 2>::new(0.3, 0.8);
         let s = m.exact(&x0, 0.0).unwrap();
         assert_eq!(s.displacement, SVector::<f64, 2>::zeros());
@@ -406,10 +408,10 @@ mod tests {
 
     #[test]
     fn rejects_unstable_cfl_and_inverting_amplitude() {
-        let mut p = params(0.1, 8);
+        let mut p = thesis_params(0.1, 8, 2);
         p.insert("cfl".into(), ParamValue::Float(0.9));
         assert_eq!(check_params(&p).unwrap_err().key, "cfl");
-        let p = params(0.4, 8);
+        let p = thesis_params(0.4, 8, 2);
         assert_eq!(check_params(&p).unwrap_err().key, "G");
     }
 }

@@ -8,7 +8,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::material::NeoHookean;
 use crate::params::{ParamError, Params};
 
-pub use mms_gong::GongMms;
+pub use mms_gong::{thesis_params, GongMms};
 
 /// The kind of value a parameter takes; checked by the experiment layer before a run starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -32,26 +32,12 @@ pub fn particles_to_grid<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{GongMms, Problem};
-    use crate::params::{ParamValue, Params};
+    use crate::benchmarks::{thesis_params, GongMms, Problem};
     use crate::shape::{Grid, LinearHat, Shape};
     use nalgebra::SMatrix;
 
     fn problem<const D: usize>() -> GongMms<D> {
-        let mut p = Params::new();
-        for (k, v) in [
-            ("G", 0.1),
-            ("E", 1e7),
-            ("nu", 0.3),
-            ("rho0", 1e3),
-            ("t_end", 0.02),
-            ("cfl", 0.4),
-        ] {
-            p.insert(k.into(), ParamValue::Float(v));
-        }
-        p.insert("ppc".into(), ParamValue::Int(3));
-        p.insert("cells".into(), ParamValue::Int(6));
-        GongMms::from_params(&p).unwrap()
+        GongMms::from_params(&thesis_params(0.1, 6, 3)).unwrap()
     }
 
     /// The transfer conserves mass and momentum and its internal forces sum to zero, to
@@ -60,13 +46,8 @@ mod tests {
         let prob = problem::<D>();
         let grid = Grid::new(&prob.domain());
         let mut particles = Particles::seed(&prob, &grid);
-        let mut state = 12345u64;
-        let mut rand = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = crate::testing::Lcg::new(12345);
+        let mut rand = || rng.unit() - 0.5;
         for p in 0..particles.len() {
             particles.x[p] += SVector::<f64, D>::from_fn(|_, _| 0.05 * rand());
             particles.x[p] = particles.x[p].map(|c| c.clamp(0.0, 1.0));

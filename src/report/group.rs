@@ -2,6 +2,7 @@
 
 use std::cmp::Ordering;
 
+use crate::experiment::Experiment;
 use crate::output::{RunStatus, RunSummary};
 use crate::params::{ParamValue, Params};
 
@@ -61,6 +62,19 @@ fn without(axes: &Params, drop: &[&str]) -> Params {
 }
 
 /// `key=value` pairs sorted by key, space separated; empty when there are none.
+/// The run's value of each of the experiment's axes, in file order (empty if absent).
+pub fn axis_values<'a>(
+    experiment: &'a Experiment,
+    run: &'a RunSummary,
+) -> impl Iterator<Item = String> + 'a {
+    experiment.axes.iter().map(|axis| {
+        run.axes
+            .get(axis)
+            .map(ToString::to_string)
+            .unwrap_or_default()
+    })
+}
+
 pub fn label(axes: &Params) -> String {
     axes.iter()
         .map(|(k, v)| format!("{k}={v}"))

@@ -6,7 +6,7 @@ use std::fmt::Write;
 use super::check::{describe, CheckFailure};
 use super::figures::Figure;
 use super::format::{general, rate};
-use super::group::{label, ordered_runs};
+use super::group::{self, label, ordered_runs};
 use super::RateRow;
 use crate::experiment::Experiment;
 use crate::output::{RunStatus, RunSummary};
@@ -67,12 +67,7 @@ fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
     header.extend(["h", "status", "steps"].map(String::from));
     let rows = runs.iter().map(|run| {
         let mut row = vec![format!("`{}`", run.run_id)];
-        row.extend(experiment.axes.iter().map(|axis| {
-            run.axes
-                .get(axis)
-                .map(ToString::to_string)
-                .unwrap_or_default()
-        }));
+        row.extend(group::axis_values(experiment, run));
         row.extend([
             h_text(run.h),
             run.status.as_str().to_string(),

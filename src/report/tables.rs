@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 
 use super::format::exact;
-use super::group::ordered_runs;
+use super::group::{self, ordered_runs};
 use super::RateRow;
 use crate::experiment::Experiment;
 use crate::output::{RunSummary, ERROR_FIELDS, NORMS};
@@ -32,12 +32,7 @@ pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
 
     let rows = ordered_runs(runs).into_iter().map(|run| {
         let mut row = vec![run.run_id.clone()];
-        row.extend(experiment.axes.iter().map(|axis| {
-            run.axes
-                .get(axis)
-                .map(ToString::to_string)
-                .unwrap_or_default()
-        }));
+        row.extend(group::axis_values(experiment, run));
         row.extend([
             exact(run.h),
             run.status.as_str().to_string(),

@@ -72,16 +72,9 @@ mod tests {
 
     /// Deterministic pseudo-random points in the grid (no RNG dependency needed).
     fn points<const D: usize>(n: usize) -> Vec<SVector<f64, D>> {
-        let mut state = 0x9e3779b97f4a7c15u64;
+        let mut rng = crate::testing::Lcg::new(0x9e3779b97f4a7c15);
         (0..n)
-            .map(|_| {
-                SVector::from_fn(|_, _| {
-                    state = state
-                        .wrapping_mul(6364136223846793005)
-                        .wrapping_add(1442695040888963407);
-                    -0.5 + 2.0 * ((state >> 11) as f64 / (1u64 << 53) as f64)
-                })
-            })
+            .map(|_| SVector::from_fn(|_, _| -0.5 + 2.0 * rng.unit()))
             .collect()
     }
 
