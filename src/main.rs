@@ -130,6 +130,7 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
         dir,
         &collected.experiment,
         &collected.runs,
+        &rates,
         failures.as_deref(),
     )
     .map_err(|e| format!("{}: {e}", dir.display()))?;

@@ -122,6 +122,7 @@ fn runs_are_reproducible_skipped_and_divergence_is_recorded() {
         &dir_a,
         &collected.experiment,
         &collected.runs,
+        &rates,
         Some(&failures),
     )
     .unwrap();

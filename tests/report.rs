@@ -238,7 +238,7 @@ fn report_files_are_written_and_deterministic() {
     let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
     let reports: Vec<_> = dirs
         .iter()
-        .map(|d| write_report(d.path(), &exp, &runs, Some(&failures)).unwrap())
+        .map(|d| write_report(d.path(), &exp, &runs, &rates, Some(&failures)).unwrap())
         .collect();
     let report = &reports[0];
     assert_eq!(report.rates, rates);
@@ -325,7 +325,8 @@ fn figure_specs_split_by_the_remaining_axes() {
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let dir = tempfile::tempdir().unwrap();
-    let report = write_report(dir.path(), &exp, &runs(), None).unwrap();
+    let runs = runs();
+    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
     let names: Vec<String> = report
         .figures
         .iter()
@@ -355,7 +356,7 @@ fn a_matrix_over_cells_alone_is_one_group() {
         })
         .into();
     let dir = tempfile::tempdir().unwrap();
-    let report = write_report(dir.path(), &exp, &runs, None).unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
     assert_eq!(
         report.figures,
         [std::path::PathBuf::from("figures/gong_conv_all_l2.png")]
@@ -366,4 +367,18 @@ fn a_matrix_over_cells_alone_is_one_group() {
 
 fn read(dir: &Path, name: &str) -> String {
     fs::read_to_string(dir.join(name)).unwrap()
+}
+
+#[test]
+fn figures_no_longer_drawn_are_removed() {
+    let runs = runs();
+    let exp = experiment(vec![], vec![]);
+    let dir = tempfile::tempdir().unwrap();
+    let stale = dir.path().join("figures").join("old_figure.png");
+    std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
+    std::fs::write(&stale, b"old").unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
+    assert!(!stale.exists());
+    assert!(!report.figures.is_empty());
+    assert!(report.figures.iter().all(|f| dir.path().join(f).exists()));
 }

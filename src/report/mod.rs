@@ -57,25 +57,41 @@ pub fn write_report(
     dir: &Path,
     experiment: &Experiment,
     runs: &[RunSummary],
+    rates: &[RateRow],
     check: Option<&[CheckFailure]>,
 ) -> io::Result<Report> {
-    let rates = fit_rates(experiment, runs);
     let figures = figures::plan(experiment, runs);
-    fs::create_dir_all(dir.join("figures"))?;
+    let figure_dir = dir.join("figures");
+    fs::create_dir_all(&figure_dir)?;
+    remove_stale_figures(&figure_dir, &figures)?;
     fs::write(
         dir.join("summary.csv"),
         tables::summary_csv(experiment, runs),
     )?;
-    fs::write(dir.join("rates.csv"), tables::rates_csv(&rates))?;
+    fs::write(dir.join("rates.csv"), tables::rates_csv(rates))?;
     for figure in &figures {
         plot::render(&dir.join(&figure.file), figure)?;
     }
-    let md = markdown::report_md(experiment, runs, &rates, &figures, check);
+    let md = markdown::report_md(experiment, runs, rates, &figures, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report {
-        rates,
+        rates: rates.to_vec(),
         figures: figures.into_iter().map(|f| f.file).collect(),
     })
+}
+
+/// PNGs left by an earlier report whose figure this report no longer draws would otherwise
+/// be committed beside the current ones.
+fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::Result<()> {
+    for entry in fs::read_dir(figure_dir)? {
+        let path = entry?.path();
+        let is_png = path.extension().is_some_and(|e| e == "png");
+        let current = figures.iter().any(|f| path.ends_with(&f.file));
+        if is_png && !current {
+            fs::remove_file(&path)?;
+        }
+    }
+    Ok(())
 }
 
 /// Fits every (group, field, norm) with at least two finished runs of positive, finite
