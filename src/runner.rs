@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::experiment::{Experiment, RunSpec};
-use crate::output::{run_path, write_run, RunStatus};
+use crate::output::{run_path, write_atomically, write_run, RunStatus};
 use crate::params::get_usize;
 use crate::solver::simulate;
 
@@ -98,9 +98,7 @@ fn estimated_cost(run: &RunSpec) -> usize {
 }
 
 fn write_experiment_copy(dir: &Path, text: &str) -> io::Result<()> {
-    let tmp = dir.join(format!(".{EXPERIMENT_COPY}.tmp-{}", std::process::id()));
-    fs::write(&tmp, text)?;
-    fs::rename(&tmp, dir.join(EXPERIMENT_COPY))
+    write_atomically(&dir.join(EXPERIMENT_COPY), |tmp| fs::write(tmp, text))
 }
 
 /// A bar on a terminal; nothing when stderr is piped or redirected.

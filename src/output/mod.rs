@@ -63,14 +63,12 @@ pub struct RunSummary {
     pub final_norms: BTreeMap<(String, String), f64>,
 }
 
-mod record;
-
-pub use record::{Errors, History, ParticleTable, RunRecord};
-
 mod atomic;
 mod reader;
+mod record;
 mod writer;
 
-pub use atomic::{run_path, write_run};
+pub use atomic::{run_path, write_atomically, write_run};
 pub use reader::read_summary;
+pub use record::{Errors, History, ParticleTable, RunRecord};
 pub use writer::write_hdf5;

@@ -46,7 +46,6 @@ pub struct RateRow {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
-    pub rates: Vec<RateRow>,
     /// Written figures, relative to the report directory.
     pub figures: Vec<PathBuf>,
 }
@@ -75,7 +74,6 @@ pub fn write_report(
     let md = markdown::report_md(experiment, runs, rates, &figures, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report {
-        rates: rates.to_vec(),
         figures: figures.into_iter().map(|f| f.file).collect(),
     })
 }

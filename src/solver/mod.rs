@@ -25,7 +25,7 @@ pub fn simulate(spec: &RunSpec) -> RunRecord {
     let mut record = match prepare(spec) {
         Ok((method, AnyProblem::D1(problem))) => run_with_method(spec, method, problem),
         Ok((method, AnyProblem::D2(problem))) => run_with_method(spec, method, problem),
-        Err(message) => failed_record(spec, message),
+        Err(message) => base_record(spec, message),
     };
     record.wall_seconds = started.elapsed().as_secs_f64();
     record
@@ -168,7 +168,7 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
     }
 
     fn into_record(self, steps: usize, status: RunStatus, message: String) -> RunRecord {
-        let mut record = failed_record(self.spec, message);
+        let mut record = base_record(self.spec, message);
         record.method = self.method;
         record.dim = D;
         record.h = self.grid.h;
@@ -208,8 +208,8 @@ fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<Fix
     fixed
 }
 
-/// A record with identity fields only; the run fills in the rest.
-fn failed_record(spec: &RunSpec, message: String) -> RunRecord {
+/// A record with the run's identity and status `failed`; a run that starts fills in the rest.
+fn base_record(spec: &RunSpec, message: String) -> RunRecord {
     let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
     RunRecord {
         spec: spec.clone(),
