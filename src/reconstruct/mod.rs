@@ -1,10 +1,23 @@
-//! Particle-to-grid transfers: what each method reconstructs on the grid from particle data.
+//! Particle-to-grid transfers: what each method reconstructs on the grid from particle data,
+//! and the local least-squares reconstructions (Shepard, MLS, IMLS) they are built from.
 
+mod basis;
+mod kernel;
+mod lattice;
+mod least_squares;
 mod shepard;
+mod solve;
+#[cfg(test)]
+mod tests;
 
 use nalgebra::SVector;
 
+pub use basis::{monomials, Degree, MAX_TERMS};
+pub use kernel::{Kernel, Weight};
+pub use lattice::Lattice;
+pub use least_squares::{FitStats, Recipe, Reconstructor, SingularMoments, Solver};
 pub use shepard::particles_to_grid;
+pub use solve::{Moments, OrthogonalBasis, RANK_TOLERANCE};
 
 /// Nodal quantities assembled from the particles each step.
 pub struct GridState<const D: usize> {

@@ -1,0 +1,214 @@
+//! Where reconstructed fields are evaluated: grid nodes, cell centres, Gauss points. Each is
+//! a tensor-product lattice of points at fixed offsets inside the cells of the grid.
+
+use nalgebra::SVector;
+
+use crate::shape::Grid;
+
+/// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
+/// offset fastest, then the cell, then the axes with the first fastest.
+#[derive(Clone, Debug)]
+pub struct Lattice<const D: usize> {
+    lower: SVector<f64, D>,
+    h: f64,
+    /// Offsets inside a cell in units of h, ascending in [0, 1).
+    offsets: Vec<f64>,
+    /// Points per axis.
+    per_axis: usize,
+    strides: [usize; D],
+}
+
+impl<const D: usize> Lattice<D> {
+    fn new(grid: &Grid<D>, offsets: Vec<f64>, per_axis: usize) -> Self {
+        let mut strides = [1; D];
+        for k in 1..D {
+            strides[k] = strides[k - 1] * per_axis;
+        }
+        Lattice {
+            lower: grid.lower,
+            h: grid.h,
+            offsets,
+            per_axis,
+            strides,
+        }
+    }
+
+    /// The grid nodes, numbered as the grid numbers them.
+    pub fn nodes(grid: &Grid<D>) -> Self {
+        Self::new(grid, vec![0.0], grid.cells + 1)
+    }
+
+    /// One point per cell at its centre (Gong's one-point quadrature, eq 5.9).
+    pub fn cell_centres(grid: &Grid<D>) -> Self {
+        Self::new(grid, vec![0.5], grid.cells)
+    }
+
+    /// `n`-point Gauss-Legendre points per axis and cell (n = 1, 2 or 3).
+    pub fn gauss(grid: &Grid<D>, n: usize) -> Self {
+        let offsets = gauss_legendre(n).0.iter().map(|&s| 0.5 + 0.5 * s).collect();
+        Self::new(grid, offsets, grid.cells * n)
+    }
+
+    pub fn len(&self) -> usize {
+        self.per_axis.pow(D as u32)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.per_axis == 0
+    }
+
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// Coordinate along one axis of lattice index `i` on that axis.
+    #[inline]
+    fn axis_coordinate(&self, axis: usize, i: usize) -> f64 {
+        let k = self.offsets.len();
+        self.lower[axis] + ((i / k) as f64 + self.offsets[i % k]) * self.h
+    }
+
+    pub fn point(&self, index: usize) -> SVector<f64, D> {
+        SVector::from_fn(|axis, _| {
+            self.axis_coordinate(axis, (index / self.strides[axis]) % self.per_axis)
+        })
+    }
+
+    /// Along `axis`, the lattice indices strictly within `radius` (in units of h) of `x`,
+    /// each with its offset (x_point - x)/h, written into `out`; returns how many. `out`
+    /// must hold `max_per_axis(radius)` entries.
+    #[inline]
+    pub fn near_on_axis(
+        &self,
+        axis: usize,
+        x: f64,
+        radius: f64,
+        out: &mut [(usize, f64)],
+    ) -> usize {
+        let k = self.offsets.len();
+        let s = (x - self.lower[axis]) / self.h;
+        let first_cell = (s - radius - 1.0).floor().max(0.0) as usize;
+        let last_cell = (s + radius).floor().max(0.0) as usize;
+        let mut n = 0;
+        for i in first_cell * k..((last_cell + 1) * k).min(self.per_axis) {
+            let d = ((i / k) as f64 + self.offsets[i % k]) - s;
+            if d.abs() < radius {
+                out[n] = (i, d);
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// An upper bound on `near_on_axis`'s count: an open interval of length 2 radius
+    /// meets at most ceil(2 radius) + 1 cells.
+    pub fn max_per_axis(&self, radius: f64) -> usize {
+        ((2.0 * radius).ceil() as usize + 1) * self.offsets.len()
+    }
+
+    pub fn stride(&self, axis: usize) -> usize {
+        self.strides[axis]
+    }
+
+    /// Quadrature weight of each point: the cell volume shared by the points of a cell with
+    /// the Gauss weights (for one offset, the whole cell).
+    pub fn quadrature_weight(&self, index: usize) -> f64 {
+        let weights = gauss_legendre(self.offsets.len()).1;
+        (0..D)
+            .map(|axis| {
+                let i = (index / self.strides[axis]) % self.per_axis;
+                0.5 * weights[i % self.offsets.len()] * self.h
+            })
+            .product()
+    }
+}
+
+/// Gauss-Legendre abscissae and weights on [-1, 1].
+fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
+    const A2: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
+    const A3: f64 = 0.774_596_669_241_483_4; // sqrt(3/5)
+    match n {
+        1 => (&[0.0], &[2.0]),
+        2 => (&[-A2, A2], &[1.0, 1.0]),
+        3 => (&[-A3, 0.0, A3], &[5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]),
+        _ => panic!("Gauss-Legendre rules with 1 to 3 points are tabulated, not {n}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::benchmarks::Domain;
+
+    fn grid<const D: usize>(cells: usize) -> Grid<D> {
+        Grid::new(&Domain {
+            lower: SVector::repeat(-1.0),
+            upper: SVector::repeat(1.0),
+            cells,
+        })
+    }
+
+    #[test]
+    fn nodes_match_the_grid_numbering() {
+        let g = grid::<2>(4);
+        let nodes = Lattice::nodes(&g);
+        assert_eq!(nodes.len(), g.num_nodes());
+        for i in 0..g.num_nodes() {
+            let ijk = g.node_coords(i);
+            let x = SVector::<f64, 2>::from_fn(|k, _| -1.0 + ijk[k] as f64 * g.h);
+            assert!((nodes.point(i) - x).norm() < 1e-15);
+        }
+    }
+
+    /// Gauss points integrate cubics exactly over the domain, cell centres linears.
+    #[test]
+    fn quadrature_weights_integrate_polynomials() {
+        let g = grid::<2>(3);
+        let cubic = |x: f64, y: f64| x * x * x + x * y * y + 1.0;
+        let linear = |x: f64, y: f64| 2.0 * x - y + 1.0;
+        let cases: [(Lattice<2>, &dyn Fn(f64, f64) -> f64); 2] = [
+            (Lattice::gauss(&g, 2), &cubic),
+            (Lattice::cell_centres(&g), &linear),
+        ];
+        for (lattice, f) in cases {
+            let sum: f64 = (0..lattice.len())
+                .map(|i| {
+                    let p = lattice.point(i);
+                    lattice.quadrature_weight(i) * f(p[0], p[1])
+                })
+                .sum();
+            assert!((sum - 4.0).abs() < 1e-13, "integral {sum}");
+        }
+    }
+
+    /// `near_on_axis` finds exactly the points within the radius, for points anywhere.
+    #[test]
+    fn near_on_axis_is_exhaustive() {
+        let g = grid::<1>(5);
+        for lattice in [
+            Lattice::nodes(&g),
+            Lattice::cell_centres(&g),
+            Lattice::gauss(&g, 2),
+        ] {
+            for radius in [1.0, 1.5, 2.0, 3.0] {
+                let mut out = vec![(0, 0.0); lattice.max_per_axis(radius)];
+                for &x in &[-1.0, -0.93, -0.2, 0.0, 0.41, 0.99, 1.0] {
+                    let n = lattice.near_on_axis(0, x, radius, &mut out);
+                    let found: Vec<usize> = out[..n].iter().map(|e| e.0).collect();
+                    // Points at exactly the radius have zero weight: either answer is right.
+                    for i in 0..lattice.len() {
+                        let d = ((lattice.point(i)[0] - x) / g.h).abs();
+                        if d < radius - 1e-9 {
+                            assert!(found.contains(&i), "x = {x}, radius {radius}: missed {i}");
+                        } else if d > radius + 1e-9 {
+                            assert!(!found.contains(&i), "x = {x}, radius {radius}: {i}");
+                        }
+                    }
+                    for &(i, d) in &out[..n] {
+                        assert!((d - (lattice.point(i)[0] - x) / g.h).abs() < 1e-12);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,139 @@
+//! The local least-squares solve at one evaluation point: from the moment matrix
+//! A = sum_p w_p q_p q_p^T to the coefficients c with shape functions phi_p = w_p q_p . c.
+//! MLS inverts A (Gaussian elimination, as Gong does); IMLS orthogonalises the basis
+//! (Tran eq 16) and needs no inversion (eq 11), dropping the polynomials the data cannot
+//! support (eq 17).
+
+use super::basis::MAX_TERMS;
+
+/// A polynomial is dropped (IMLS) or the moment matrix declared singular (MLS) when the part
+/// of it the data can see is at most this fraction of its weighted norm. For IMLS the ratio
+/// <p_i, p_i> / <q_i, q_i> is sin^2 of the angle between q_i and the span of the earlier
+/// basis: 1e-10 is an angle of 1e-5 rad. Rounding puts a truly dependent monomial near
+/// 1e-16 and a supported one above about 1e-4 for the point sets MPM produces, so the
+/// threshold separates the two cases by orders of magnitude either way.
+pub const RANK_TOLERANCE: f64 = 1e-10;
+
+/// Row-major m x m moment matrix, m <= MAX_TERMS.
+pub type Moments = [f64; MAX_TERMS * MAX_TERMS];
+
+/// The weighted orthogonal polynomials p_i = sum_j coeffs[i][j] q_j of Tran eq 16, built
+/// from the inner products <q_i, q_j> = A_ij (eq 7).
+#[derive(Clone, Debug)]
+pub struct OrthogonalBasis {
+    pub terms: usize,
+    /// Unit lower-triangular: p_i = q_i - sum_{k<i} (<q_i, p_k>/<p_k, p_k>) p_k.
+    pub coeffs: [[f64; MAX_TERMS]; MAX_TERMS],
+    /// <p_i, p_i>.
+    pub norms: [f64; MAX_TERMS],
+    /// Whether p_i is supported by the data (else it is left out of every sum).
+    pub kept: [bool; MAX_TERMS],
+}
+
+impl OrthogonalBasis {
+    pub fn from_moments(a: &Moments, terms: usize) -> Self {
+        let mut basis = OrthogonalBasis {
+            terms,
+            coeffs: [[0.0; MAX_TERMS]; MAX_TERMS],
+            norms: [0.0; MAX_TERMS],
+            kept: [false; MAX_TERMS],
+        };
+        for i in 0..terms {
+            let mut c = [0.0; MAX_TERMS];
+            c[i] = 1.0;
+            for k in 0..i {
+                if !basis.kept[k] {
+                    continue;
+                }
+                let ck = &basis.coeffs[k];
+                let q_i_dot_p_k: f64 = (0..=k).map(|j| ck[j] * a[i * MAX_TERMS + j]).sum();
+                let ratio = q_i_dot_p_k / basis.norms[k];
+                for j in 0..=k {
+                    c[j] -= ratio * ck[j];
+                }
+            }
+            let norm = quadratic_form(a, &c, i + 1);
+            basis.coeffs[i] = c;
+            basis.norms[i] = norm;
+            basis.kept[i] = norm > RANK_TOLERANCE * a[i * MAX_TERMS + i];
+        }
+        basis
+    }
+
+    pub fn rank(&self) -> usize {
+        self.kept[..self.terms].iter().filter(|&&k| k).count()
+    }
+
+    /// p_i at a point whose monomials are `q`.
+    pub fn eval(&self, i: usize, q: &[f64]) -> f64 {
+        (0..=i).map(|j| self.coeffs[i][j] * q[j]).sum()
+    }
+
+    /// c of phi_p = w_p q_p . c: u^h = sum_i p_i(x) <p_i, u>/<p_i, p_i> (eq 11, 13) with
+    /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point.
+    pub fn shape_coefficients(&self) -> [f64; MAX_TERMS] {
+        let mut out = [0.0; MAX_TERMS];
+        for i in 0..self.terms {
+            if !self.kept[i] {
+                continue;
+            }
+            let scale = self.coeffs[i][0] / self.norms[i];
+            for j in 0..=i {
+                out[j] += scale * self.coeffs[i][j];
+            }
+        }
+        out
+    }
+}
+
+/// c^T A c over the leading `n` entries.
+fn quadratic_form(a: &Moments, c: &[f64; MAX_TERMS], n: usize) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..n {
+        let row: f64 = (0..n).map(|j| a[i * MAX_TERMS + j] * c[j]).sum();
+        sum += c[i] * row;
+    }
+    sum
+}
+
+/// MLS: c = A^-1 e_1 by Gaussian elimination with partial pivoting (Gong sec 5.4). `None`
+/// when a pivot is at most `RANK_TOLERANCE` times the largest diagonal entry.
+pub fn mls_coefficients(a: &Moments, terms: usize) -> Option<[f64; MAX_TERMS]> {
+    let n = terms;
+    let scale = (0..n).map(|i| a[i * MAX_TERMS + i]).fold(0.0, f64::max);
+    let mut m = *a;
+    let mut rhs = [0.0; MAX_TERMS];
+    rhs[0] = 1.0;
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&r, &s| {
+                m[r * MAX_TERMS + col]
+                    .abs()
+                    .total_cmp(&m[s * MAX_TERMS + col].abs())
+            })
+            .expect("non-empty range");
+        let p = m[pivot * MAX_TERMS + col];
+        if !(p.abs() > RANK_TOLERANCE * scale) {
+            return None;
+        }
+        if pivot != col {
+            for j in 0..n {
+                m.swap(col * MAX_TERMS + j, pivot * MAX_TERMS + j);
+            }
+            rhs.swap(col, pivot);
+        }
+        for r in col + 1..n {
+            let factor = m[r * MAX_TERMS + col] / p;
+            for j in col..n {
+                m[r * MAX_TERMS + j] -= factor * m[col * MAX_TERMS + j];
+            }
+            rhs[r] -= factor * rhs[col];
+        }
+    }
+    let mut c = [0.0; MAX_TERMS];
+    for r in (0..n).rev() {
+        let tail: f64 = (r + 1..n).map(|j| m[r * MAX_TERMS + j] * c[j]).sum();
+        c[r] = (rhs[r] - tail) / m[r * MAX_TERMS + r];
+    }
+    Some(c)
+}

@@ -1,0 +1,288 @@
+//! Reproduction, agreement and rank-loss tests of the least-squares reconstructions.
+
+use nalgebra::SVector;
+
+use super::*;
+use crate::benchmarks::Domain;
+use crate::shape::Grid;
+use crate::testing::Lcg;
+
+fn grid<const D: usize>(cells: usize) -> Grid<D> {
+    Grid::new(&Domain {
+        lower: SVector::repeat(-1.0),
+        upper: SVector::repeat(1.0),
+        cells,
+    })
+}
+
+fn recipe(weight: Weight, scale: f64, degree: Degree, solver: Solver) -> Recipe {
+    Recipe {
+        kernel: Kernel { weight, scale },
+        degree,
+        solver,
+    }
+}
+
+/// `n` uniformly random points in [-1, 1]^D.
+fn random_points<const D: usize>(n: usize, seed: u64) -> Vec<SVector<f64, D>> {
+    let mut rng = Lcg::new(seed);
+    (0..n)
+        .map(|_| SVector::from_fn(|_, _| -1.0 + 2.0 * rng.unit()))
+        .collect()
+}
+
+/// Reconstructs `f` sampled at `x` on the lattice; returns (point, exact, reconstructed)
+/// for the covered points.
+fn reconstruct<const D: usize>(
+    rec: &mut Reconstructor<D>,
+    x: &[SVector<f64, D>],
+    f: impl Fn(&SVector<f64, D>) -> f64,
+) -> Vec<(SVector<f64, D>, f64, f64)> {
+    rec.fit(x).expect("fit");
+    let values: Vec<f64> = x.iter().map(&f).collect();
+    let mut out = vec![0.0; rec.lattice().len()];
+    rec.apply(&values, &mut out);
+    (0..out.len())
+        .filter(|&e| rec.covered(e))
+        .map(|e| {
+            let xe = rec.lattice().point(e);
+            (xe, f(&xe), out[e])
+        })
+        .collect()
+}
+
+fn check_reproduction<const D: usize>(degree: Degree, solver: Solver, weight: Weight) {
+    let g = grid::<D>(8);
+    let x = random_points::<D>(400 * D * D, 7 + D as u64);
+    let mut rec = Reconstructor::new(recipe(weight, 1.0, degree, solver), Lattice::nodes(&g));
+    let linear = |p: &SVector<f64, D>| 0.7 - 1.3 * p[0] + 2.1 * p[D - 1];
+    let quadratic = |p: &SVector<f64, D>| linear(p) + 0.9 * p[0] * p[D - 1] - 1.7 * p[0] * p[0];
+    let cases: Vec<&dyn Fn(&SVector<f64, D>) -> f64> = if degree == Degree::QUADRATIC {
+        vec![&linear, &quadratic]
+    } else {
+        vec![&linear]
+    };
+    for f in cases {
+        let rows = reconstruct(&mut rec, &x, f);
+        assert_eq!(rows.len(), g.num_nodes(), "every node is reached");
+        for (xe, exact, got) in rows {
+            assert!(
+                (exact - got).abs() < 1e-12,
+                "D={D} {degree:?} {solver:?} {weight}: at {xe:?} exact {exact} got {got}"
+            );
+        }
+    }
+}
+
+#[test]
+fn mls_and_imls_reproduce_their_basis_on_random_points() {
+    for solver in [Solver::Mls, Solver::Imls] {
+        for weight in [Weight::Hat, Weight::QuadraticSpline, Weight::CubicSpline] {
+            check_reproduction::<1>(Degree::LINEAR, solver, weight);
+            check_reproduction::<2>(Degree::LINEAR, solver, weight);
+            check_reproduction::<1>(Degree::QUADRATIC, solver, weight);
+            check_reproduction::<2>(Degree::QUADRATIC, solver, weight);
+        }
+    }
+}
+
+/// Shepard (degree 0) reproduces constants only: a linear function on random points is
+/// off by O(h).
+#[test]
+fn shepard_reproduces_constants_not_linears() {
+    let g = grid::<1>(10);
+    let x = random_points::<1>(40, 3);
+    let mut rec = Reconstructor::new(
+        recipe(Weight::Hat, 1.0, Degree::CONSTANT, Solver::Mls),
+        Lattice::nodes(&g),
+    );
+    for (_, exact, got) in reconstruct(&mut rec, &x, |_| 2.5) {
+        assert!((exact - got).abs() < 1e-14);
+    }
+    let worst = reconstruct(&mut rec, &x, |p| p[0])
+        .iter()
+        .map(|r| (r.1 - r.2).abs())
+        .fold(0.0, f64::max);
+    assert!(worst > 1e-3, "largest error {worst}");
+}
+
+/// Where the moment matrix is well conditioned, IMLS and MLS are the same reconstruction.
+fn check_imls_equals_mls<const D: usize>(degree: Degree) {
+    let g = grid::<D>(6);
+    let x = random_points::<D>(300 * D * D, 11);
+    let f = |p: &SVector<f64, D>| (3.0 * p[0]).sin() + (2.0 * p[D - 1]).cos();
+    let weight = Weight::QuadraticSpline;
+    let mut mls = Reconstructor::new(
+        recipe(weight, 1.0, degree, Solver::Mls),
+        Lattice::gauss(&g, 2),
+    );
+    let mut imls = Reconstructor::new(
+        recipe(weight, 1.0, degree, Solver::Imls),
+        Lattice::gauss(&g, 2),
+    );
+    let a = reconstruct(&mut mls, &x, f);
+    let b = reconstruct(&mut imls, &x, f);
+    assert_eq!(a.len(), b.len());
+    for (ra, rb) in a.iter().zip(&b) {
+        assert!((ra.2 - rb.2).abs() < 1e-11, "MLS {} vs IMLS {}", ra.2, rb.2);
+    }
+}
+
+#[test]
+fn imls_equals_mls_when_well_conditioned() {
+    check_imls_equals_mls::<1>(Degree::LINEAR);
+    check_imls_equals_mls::<1>(Degree::QUADRATIC);
+    check_imls_equals_mls::<2>(Degree::LINEAR);
+    check_imls_equals_mls::<2>(Degree::QUADRATIC);
+}
+
+/// Moments of `points` about the origin with unit weights, as the orthogonalisation sees them.
+fn moments<const D: usize>(points: &[SVector<f64, D>], degree: Degree) -> (Moments, usize) {
+    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
+    let mut q = [0.0; MAX_TERMS];
+    let mut terms = 0;
+    for p in points {
+        terms = monomials(degree, p, &mut q);
+        for r in 0..terms {
+            for s in 0..terms {
+                a[r * MAX_TERMS + s] += q[r] * q[s];
+            }
+        }
+    }
+    (a, terms)
+}
+
+/// Tran eq 17: with r independent data the basis keeps r polynomials. 1, 2 and 3 points
+/// with the quadratic basis in 1D; with the linear basis in 2D, collinear points lose one.
+#[test]
+fn imls_degrades_to_the_rank_of_the_data() {
+    let pts =
+        |xs: &[f64]| -> Vec<SVector<f64, 1>> { xs.iter().map(|&x| SVector::from([x])).collect() };
+    for (xs, rank) in [
+        (vec![0.3], 1),
+        (vec![-0.5, 0.5], 2),
+        (vec![-0.5, 0.1, 0.5], 3),
+        (vec![0.2, 0.2, 0.2], 1),
+    ] {
+        let (a, terms) = moments(&pts(&xs), Degree::QUADRATIC);
+        let basis = OrthogonalBasis::from_moments(&a, terms);
+        assert_eq!(basis.rank(), rank, "points {xs:?}");
+    }
+    let (a, terms) = moments(&pts(&[-0.5, 0.5]), Degree::LINEAR);
+    assert_eq!(OrthogonalBasis::from_moments(&a, terms).rank(), 2);
+
+    let p2 = |v: &[(f64, f64)]| -> Vec<SVector<f64, 2>> {
+        v.iter().map(|&(x, y)| SVector::from([x, y])).collect()
+    };
+    for (v, rank) in [
+        (vec![(0.1, 0.2)], 1),
+        (vec![(0.0, 0.0), (0.3, 0.6), (-0.2, -0.4)], 2),
+        (vec![(0.0, 0.0), (0.3, 0.6), (-0.2, 0.4)], 3),
+    ] {
+        let (a, terms) = moments(&p2(&v), Degree::LINEAR);
+        assert_eq!(
+            OrthogonalBasis::from_moments(&a, terms).rank(),
+            rank,
+            "{v:?}"
+        );
+        // MLS has no such fallback: the same data make its moment matrix singular.
+        assert_eq!(
+            super::solve::mls_coefficients(&a, terms).is_some(),
+            rank == terms
+        );
+    }
+}
+
+/// Tran Fig 3: for two points p3 vanishes at both, so <p3, p3> = 0, and the fit through
+/// the two kept polynomials still reproduces the linear data exactly.
+#[test]
+fn two_points_make_the_quadratic_polynomial_vanish() {
+    let xs = [-0.6, 0.4];
+    let w = |x: f64| Weight::QuadraticSpline.eval(x.abs() / 2.0);
+    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
+    let mut q = [0.0; MAX_TERMS];
+    for &x in &xs {
+        monomials(Degree::QUADRATIC, &SVector::<f64, 1>::from([x]), &mut q);
+        for r in 0..3 {
+            for s in 0..3 {
+                a[r * MAX_TERMS + s] += w(x) * q[r] * q[s];
+            }
+        }
+    }
+    let basis = OrthogonalBasis::from_moments(&a, 3);
+    assert!(!basis.kept[2]);
+    assert!(basis.norms[2].abs() < 1e-15 * a[2 * MAX_TERMS + 2]);
+    for &x in &xs {
+        monomials(Degree::QUADRATIC, &SVector::<f64, 1>::from([x]), &mut q);
+        assert!(
+            basis.eval(2, &q).abs() < 1e-14,
+            "p3({x}) = {}",
+            basis.eval(2, &q)
+        );
+    }
+    // u = 2 - 3x at the points; the degraded fit evaluated at 0 gives u(0) = 2.
+    let c = basis.shape_coefficients();
+    let u0: f64 = xs
+        .iter()
+        .map(|&x| {
+            monomials(Degree::QUADRATIC, &SVector::<f64, 1>::from([x]), &mut q);
+            w(x) * (0..3).map(|j| q[j] * c[j]).sum::<f64>() * (2.0 - 3.0 * x)
+        })
+        .sum();
+    assert!((u0 - 2.0).abs() < 1e-14);
+}
+
+/// A reconstruction with too few points counts its rank losses (IMLS) or stops (MLS).
+#[test]
+fn sparse_data_is_counted_or_refused() {
+    let g = grid::<1>(4);
+    let x = vec![SVector::<f64, 1>::from([0.05])];
+    let mut imls = Reconstructor::new(
+        recipe(Weight::CubicSpline, 1.0, Degree::LINEAR, Solver::Imls),
+        Lattice::nodes(&g),
+    );
+    let stats = imls.fit(&x).unwrap();
+    assert_eq!(stats.fits, 4, "nodes within 2h of the point");
+    assert_eq!(stats.rank_deficient, 4);
+    let mut mls = Reconstructor::new(
+        recipe(Weight::CubicSpline, 1.0, Degree::LINEAR, Solver::Mls),
+        Lattice::nodes(&g),
+    );
+    assert!(mls.fit(&x).is_err());
+}
+
+/// Gong Table 4.1: 10 cells on [-1, 1] (h = 0.2), 4 cell-centred points per cell, Shepard
+/// with the hat weight. Printed to 4 decimals; the boundary values of u = x are exactly
+/// -/+ 11h/32 = 0.06875, half-way between the printed 0.0688 and 0.0687.
+#[test]
+fn shepard_reproduces_gong_table_4_1() {
+    let g = grid::<1>(10);
+    let x: Vec<SVector<f64, 1>> = (0..40)
+        .map(|p| SVector::from([-1.0 + (p as f64 + 0.5) * 0.05]))
+        .collect();
+    let mut rec = Reconstructor::new(
+        recipe(Weight::Hat, 1.0, Degree::CONSTANT, Solver::Mls),
+        Lattice::nodes(&g),
+    );
+    let printed_x = [-0.0688, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0687];
+    let printed_x2 = [
+        0.1306, -0.0069, -0.0069, -0.0069, -0.0069, -0.0069, -0.0069, -0.0069, -0.0069, -0.0069,
+        0.1306,
+    ];
+    let ones = reconstruct(&mut rec, &x, |_| 1.0);
+    let lin = reconstruct(&mut rec, &x, |p| p[0]);
+    let quad = reconstruct(&mut rec, &x, |p| p[0] * p[0]);
+    for i in 0..11 {
+        assert!((ones[i].1 - ones[i].2).abs() < 1e-15);
+        assert!(
+            (lin[i].1 - lin[i].2 - printed_x[i]).abs() <= 1e-4 + 1e-12,
+            "x at node {i}"
+        );
+        assert!(
+            (quad[i].1 - quad[i].2 - printed_x2[i]).abs() <= 0.5e-4 + 1e-12,
+            "x^2 at node {i}"
+        );
+    }
+    assert!((lin[0].1 - lin[0].2 + 11.0 * 0.2 / 32.0).abs() < 1e-14);
+    assert!((quad[5].1 - quad[5].2 + 11.0 * 0.04 / 64.0).abs() < 1e-14);
+}
