@@ -113,7 +113,8 @@ pub fn mls_coefficients(a: &Moments, terms: usize) -> Option<[f64; MAX_TERMS]> {
             })
             .expect("non-empty range");
         let p = m[pivot * MAX_TERMS + col];
-        if !(p.abs() > RANK_TOLERANCE * scale) {
+        // NaN moments are singular too.
+        if p.abs() <= RANK_TOLERANCE * scale || p.is_nan() {
             return None;
         }
         if pivot != col {
