@@ -166,7 +166,8 @@ mod tests {
         let g = grid::<2>(3);
         let cubic = |x: f64, y: f64| x * x * x + x * y * y + 1.0;
         let linear = |x: f64, y: f64| 2.0 * x - y + 1.0;
-        let cases: [(Lattice<2>, &dyn Fn(f64, f64) -> f64); 2] = [
+        type Integrand<'a> = &'a dyn Fn(f64, f64) -> f64;
+        let cases: [(Lattice<2>, Integrand); 2] = [
             (Lattice::gauss(&g, 2), &cubic),
             (Lattice::cell_centres(&g), &linear),
         ];

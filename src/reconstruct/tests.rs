@@ -57,7 +57,8 @@ fn check_reproduction<const D: usize>(degree: Degree, solver: Solver, weight: We
     let mut rec = Reconstructor::new(recipe(weight, 1.0, degree, solver), Lattice::nodes(&g));
     let linear = |p: &SVector<f64, D>| 0.7 - 1.3 * p[0] + 2.1 * p[D - 1];
     let quadratic = |p: &SVector<f64, D>| linear(p) + 0.9 * p[0] * p[D - 1] - 1.7 * p[0] * p[0];
-    let cases: Vec<&dyn Fn(&SVector<f64, D>) -> f64> = if degree == Degree::QUADRATIC {
+    type Field<'a, const D: usize> = &'a dyn Fn(&SVector<f64, D>) -> f64;
+    let cases: Vec<Field<D>> = if degree == Degree::QUADRATIC {
         vec![&linear, &quadratic]
     } else {
         vec![&linear]
