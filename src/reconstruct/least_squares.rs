@@ -46,6 +46,21 @@ impl AddAssign for FitStats {
     }
 }
 
+impl fmt::Display for Recipe {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let solver = match self.solver {
+            Solver::Mls => "mls",
+            Solver::Imls => "imls",
+        };
+        write!(
+            f,
+            "{solver}[{}, degree {}]",
+            self.kernel,
+            self.degree.value()
+        )
+    }
+}
+
 /// The MLS moment matrix at an evaluation point is singular.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SingularMoments {

@@ -5,6 +5,7 @@ mod basis;
 mod kernel;
 mod lattice;
 mod least_squares;
+mod quadrature;
 mod shepard;
 mod solve;
 #[cfg(test)]
@@ -16,6 +17,7 @@ pub use basis::{monomials, Degree, MAX_TERMS};
 pub use kernel::{Kernel, Weight};
 pub use lattice::Lattice;
 pub use least_squares::{FitStats, Recipe, Reconstructor, SingularMoments, Solver};
+pub use quadrature::{QuadratureRecipe, QuadratureTransfer};
 pub use shepard::particles_to_grid;
 pub use solve::{Moments, OrthogonalBasis, RANK_TOLERANCE};
 
@@ -23,27 +25,34 @@ pub use solve::{Moments, OrthogonalBasis, RANK_TOLERANCE};
 pub struct GridState<const D: usize> {
     /// Lumped mass m_i.
     pub mass: Vec<f64>,
-    /// Momentum (m v)_i, then the velocity v_i^{s-1/2} once the grid is solved.
-    pub momentum: Vec<SVector<f64, D>>,
+    /// Nodal velocity at the start of the step (v_i^{s-1/2} for leapfrog, v_i^t for MUSL).
+    pub velocity: Vec<SVector<f64, D>>,
     /// Internal plus external force f_i, then the acceleration a_i once the grid is solved.
     pub force: Vec<SVector<f64, D>>,
-    /// v_i^{s+1/2}.
-    pub velocity: Vec<SVector<f64, D>>,
+    /// Nodal velocity at the end of the step.
+    pub velocity_new: Vec<SVector<f64, D>>,
+    /// Nodes at or below this mass are empty: the hat's gradient does not vanish where its
+    /// value does, so a node touched only at N ~ 0 would get an unbounded acceleration.
+    pub empty_mass: f64,
 }
 
+/// Empty-node threshold as a fraction of the largest particle mass.
+const EMPTY_NODE_FRACTION: f64 = 1e-12;
+
 impl<const D: usize> GridState<D> {
-    pub fn new(nodes: usize) -> Self {
+    pub fn new(nodes: usize, particle_mass: f64) -> Self {
         GridState {
             mass: vec![0.0; nodes],
-            momentum: vec![SVector::zeros(); nodes],
-            force: vec![SVector::zeros(); nodes],
             velocity: vec![SVector::zeros(); nodes],
+            force: vec![SVector::zeros(); nodes],
+            velocity_new: vec![SVector::zeros(); nodes],
+            empty_mass: EMPTY_NODE_FRACTION * particle_mass,
         }
     }
 
     pub fn clear(&mut self) {
         self.mass.fill(0.0);
-        self.momentum.fill(SVector::zeros());
+        self.velocity.fill(SVector::zeros());
         self.force.fill(SVector::zeros());
     }
 }

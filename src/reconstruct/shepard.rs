@@ -5,7 +5,8 @@ use crate::particles::Particles;
 use crate::shape::Stencils;
 
 /// The original MPM mapping (Gong sec 4.4 step 1): lumped mass m_i = sum_p M_p N_ip,
-/// momentum (m v)_i = sum_p M_p v_p N_ip (Shepard interpolation of v with weight M_p N_ip),
+/// velocity v_i = sum_p M_p v_p N_ip / m_i (Shepard interpolation with weight M_p N_ip; left
+/// zero at empty nodes),
 /// and force f_i = -sum_p V_p sigma_p grad N_ip + sum_p M_p b_p N_ip by one-point
 /// quadrature at the particles (V_p sigma_p = M_p sigma_p / rho_p, Gong's M_p sigma^s_p).
 /// Particles are visited in order, so the sums are the same on every run.
@@ -23,9 +24,16 @@ pub fn particles_to_grid<const D: usize>(
         let mb = body_force[p] * m;
         for (i, w, g) in stencils.of(p) {
             grid.mass[i] += m * w;
-            grid.momentum[i] += mv * w;
+            grid.velocity[i] += mv * w;
             grid.force[i] += mb * w - vs * g;
         }
+    }
+    for (v, &m) in grid.velocity.iter_mut().zip(&grid.mass) {
+        *v = if m > grid.empty_mass {
+            *v / m
+        } else {
+            SVector::zeros()
+        };
     }
 }
 
@@ -58,7 +66,7 @@ mod tests {
         let body = vec![SVector::<f64, D>::from_fn(|k, _| k as f64 - 9.81); particles.len()];
         let mut st = Stencils::new(Shape::<D>::nodes_per_point(&LinearHat), particles.len());
         st.update(&LinearHat, &grid, &particles.x).unwrap();
-        let mut nodes = GridState::new(grid.num_nodes());
+        let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
         particles_to_grid(&st, &particles, &body, &mut nodes);
 
         let total_mass: f64 = particles.mass.iter().sum();
@@ -69,7 +77,9 @@ mod tests {
             .map(|p| body[p] * particles.mass[p])
             .sum();
         let grid_mass: f64 = nodes.mass.iter().sum();
-        let grid_momentum: SVector<f64, D> = nodes.momentum.iter().sum();
+        let grid_momentum: SVector<f64, D> = (0..grid.num_nodes())
+            .map(|i| nodes.velocity[i] * nodes.mass[i])
+            .sum();
         let grid_force: SVector<f64, D> = nodes.force.iter().sum();
         assert!((grid_mass - total_mass).abs() < 1e-13 * total_mass);
         assert!((grid_momentum - momentum).norm() < 1e-12 * (1.0 + momentum.norm()));

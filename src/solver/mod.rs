@@ -1,6 +1,7 @@
 //! One run: build the problem, seed particles, step, sample, and return the record.
 
 mod recorder;
+mod transfer;
 
 use std::time::Instant;
 
@@ -8,15 +9,15 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, Problem};
 use crate::experiment::RunSpec;
-use crate::integrate::leapfrog::{self, FixedDof};
-use crate::integrate::Divergence;
-use crate::methods::{self, Method, ShapeKind};
+use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
+use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
-use crate::reconstruct::{particles_to_grid, GridState};
+use crate::reconstruct::{FitStats, GridState};
 use crate::shape::{Grid, LinearHat, Shape, Stencils};
 
 use recorder::Recorder;
+use transfer::Transfer;
 
 /// Runs one configuration. Never panics on bad numbers: a run that cannot start is
 /// `failed`, a run that blows up is `diverged`, each with the reason in `message`.
@@ -62,9 +63,13 @@ struct Run<'a, const D: usize, S: Shape<D>> {
     grid: Grid<D>,
     particles: Particles<D>,
     stencils: Stencils<D>,
+    transfer: Transfer<D>,
     nodes: GridState<D>,
     fixed: Vec<FixedDof>,
     body_force: Vec<SVector<f64, D>>,
+    /// Nodal velocity rebuilt after the particles moved (MUSL only).
+    remapped: Vec<SVector<f64, D>>,
+    fits: FitStats,
     recorder: Recorder,
 }
 
@@ -75,16 +80,20 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
         let n = particles.len();
+        let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
         Run {
             spec,
             method,
             stencils: Stencils::new(shape.nodes_per_point(), n),
+            transfer: Transfer::new(&method.transfer, &grid, &shape),
             shape,
-            nodes: GridState::new(grid.num_nodes()),
+            nodes: GridState::new(grid.num_nodes(), particle_mass),
+            remapped: vec![SVector::zeros(); grid.num_nodes()],
             grid,
             particles,
             fixed,
             body_force: vec![SVector::zeros(); n],
+            fits: FitStats::default(),
             recorder: Recorder::new(),
             problem,
         }
@@ -111,8 +120,6 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         let dt = self.problem.dt();
         let steps = self.problem.steps();
         let every = self.spec.output_every;
-        let material = self.problem.material();
-        let particle_mass = self.particles.mass.iter().cloned().fold(0.0, f64::max);
         let mut synced = vec![SVector::zeros(); self.particles.len()];
         if let Err(p) = self
             .stencils
@@ -123,38 +130,40 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         for s in 0..=steps {
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
-            particles_to_grid(
+            match self.transfer.map_to_grid(
                 &self.stencils,
                 &self.particles,
                 &self.body_force,
                 &mut self.nodes,
-            );
-            let kick = if s == 0 { 0.5 * dt } else { dt };
-            leapfrog::solve_grid(&mut self.nodes, &self.fixed, kick, particle_mass);
+            ) {
+                Ok(stats) => self.fits += stats,
+                Err(reason) => return (s, Err((s, reason))),
+            }
+            // Leapfrog starts with a half kick from v^0 to v^{1/2}.
+            let leapfrog = self.method.integrator == IntegratorKind::Leapfrog;
+            let kick = if leapfrog && s == 0 { 0.5 * dt } else { dt };
+            integrate::solve_grid(&mut self.nodes, &self.fixed, kick);
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
-                let half = if s == 0 { 0.0 } else { 0.5 * dt };
-                leapfrog::synchronized_velocity(
-                    &self.stencils,
-                    &self.particles,
-                    &self.nodes,
-                    half,
-                    &mut synced,
-                );
+                let velocity = if leapfrog {
+                    let half = if s == 0 { 0.0 } else { 0.5 * dt };
+                    leapfrog::synchronized_velocity(
+                        &self.stencils,
+                        &self.particles,
+                        &self.nodes,
+                        half,
+                        &mut synced,
+                    );
+                    &synced
+                } else {
+                    &self.particles.v
+                };
                 self.recorder
-                    .sample(s, t, &self.particles, &synced, self.problem.as_ref());
+                    .sample(s, t, &self.particles, velocity, self.problem.as_ref());
             }
             if s == steps {
                 break;
             }
-            let updated = leapfrog::update_particles(
-                &self.stencils,
-                &mut self.particles,
-                &self.nodes,
-                kick,
-                dt,
-                &material,
-            );
-            if let Err(reason) = updated {
+            if let Err(reason) = self.update_particles(kick, dt) {
                 return (s, Err((s + 1, reason)));
             }
             if let Err(p) = self
@@ -165,6 +174,38 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
             }
         }
         (steps, Ok(()))
+    }
+
+    /// Step 3 of the method's integrator, after the grid solve.
+    fn update_particles(&mut self, kick: f64, dt: f64) -> Result<(), Divergence> {
+        let material = self.problem.material();
+        match self.method.integrator {
+            IntegratorKind::Leapfrog => leapfrog::update_particles(
+                &self.stencils,
+                &mut self.particles,
+                &self.nodes,
+                kick,
+                dt,
+                &material,
+            ),
+            IntegratorKind::Musl => {
+                musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, dt)?;
+                self.transfer.remap_velocity(
+                    &self.stencils,
+                    &self.particles,
+                    &self.nodes,
+                    &mut self.remapped,
+                );
+                integrate::apply_fixed(&mut self.remapped, &self.fixed);
+                musl::deform_particles(
+                    &self.stencils,
+                    &mut self.particles,
+                    &self.remapped,
+                    dt,
+                    &material,
+                )
+            }
+        }
     }
 
     fn into_record(self, steps: usize, status: RunStatus, message: String) -> RunRecord {

@@ -1,0 +1,36 @@
+//! The deformation update shared by the integrators: F, J and the stress of one particle.
+
+use nalgebra::SMatrix;
+
+use super::Divergence;
+use crate::material::{det, NeoHookean};
+use crate::particles::Particles;
+
+/// F_p = (I + dt grad v_p) F_p, J_p = det F_p and the stress, after checking that the
+/// new state is finite and not inverted. `accel_finite` reports the acceleration gathered in
+/// the same pass, so that a non-finite grid is caught at the first particle that sees it.
+#[inline]
+pub(super) fn deform_particle<const D: usize>(
+    particles: &mut Particles<D>,
+    p: usize,
+    grad_v: &SMatrix<f64, D, D>,
+    dt: f64,
+    accel_finite: bool,
+    material: &NeoHookean,
+) -> Result<(), Divergence> {
+    let f = (SMatrix::<f64, D, D>::identity() + grad_v * dt) * particles.f[p];
+    let j = det(&f);
+    if !(j.is_finite() && accel_finite) {
+        return Err(Divergence::NonFinite {
+            particle: p,
+            what: "state",
+        });
+    }
+    if j <= 0.0 {
+        return Err(Divergence::Jacobian { particle: p, j });
+    }
+    particles.f[p] = f;
+    particles.j[p] = j;
+    particles.stress[p] = material.cauchy(&f, j);
+    Ok(())
+}

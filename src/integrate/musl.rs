@@ -1,0 +1,59 @@
+//! The modified update-stress-last scheme of Tran et al. eqs 31-40: velocities at whole
+//! steps, the particles moved with the new nodal velocity, then the nodal velocity rebuilt
+//! from the updated particle velocities (v_i^L, eq 36) and used for the velocity gradient.
+//! N and grad N are taken at x_p^t throughout the step: the grid moves with the material
+//! until it is reset at the end (Tran: "at that moment, the grid configuration is reset").
+
+use nalgebra::{SMatrix, SVector};
+
+use super::deform::deform_particle;
+use super::Divergence;
+use crate::material::NeoHookean;
+use crate::particles::Particles;
+use crate::reconstruct::GridState;
+use crate::shape::Stencils;
+
+/// Eqs 34-35: v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i^{t+1}.
+pub fn move_particles<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &mut Particles<D>,
+    grid: &GridState<D>,
+    dt: f64,
+) -> Result<(), Divergence> {
+    for p in 0..particles.len() {
+        let mut a = SVector::<f64, D>::zeros();
+        let mut v = SVector::<f64, D>::zeros();
+        for (i, w, _) in stencils.of(p) {
+            a += grid.force[i] * w;
+            v += grid.velocity_new[i] * w;
+        }
+        if !a.iter().chain(v.iter()).all(|c| c.is_finite()) {
+            return Err(Divergence::NonFinite {
+                particle: p,
+                what: "velocity",
+            });
+        }
+        particles.v[p] += a * dt;
+        particles.x[p] += v * dt;
+    }
+    Ok(())
+}
+
+/// Eqs 37-40 with grad N (eq 37 prints N): grad v_p = sum_i v_i^L (x) grad N_ip, then F, J
+/// and the stress.
+pub fn deform_particles<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &mut Particles<D>,
+    remapped: &[SVector<f64, D>],
+    dt: f64,
+    material: &NeoHookean,
+) -> Result<(), Divergence> {
+    for p in 0..particles.len() {
+        let grad_v: SMatrix<f64, D, D> = stencils
+            .of(p)
+            .map(|(i, _, g)| remapped[i] * g.transpose())
+            .sum();
+        deform_particle(particles, p, &grad_v, dt, true, material)?;
+    }
+    Ok(())
+}

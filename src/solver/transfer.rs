@@ -1,0 +1,74 @@
+//! The particle-to-grid transfer of a run, chosen from the method's parts.
+
+use nalgebra::SVector;
+
+use crate::integrate::Divergence;
+use crate::methods::TransferKind;
+use crate::particles::Particles;
+use crate::reconstruct::{particles_to_grid, FitStats, GridState, QuadratureTransfer};
+use crate::shape::{Grid, Shape, Stencils};
+
+pub enum Transfer<const D: usize> {
+    Shepard,
+    Quadrature(Box<QuadratureTransfer<D>>),
+}
+
+impl<const D: usize> Transfer<D> {
+    pub fn new<S: Shape<D>>(kind: &TransferKind, grid: &Grid<D>, shape: &S) -> Self {
+        match kind {
+            TransferKind::Shepard => Transfer::Shepard,
+            TransferKind::Quadrature(recipe) => {
+                Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid, shape)))
+            }
+        }
+    }
+
+    /// Nodal mass, velocity and force from the particles; the fit counters of the step.
+    pub fn map_to_grid(
+        &mut self,
+        stencils: &Stencils<D>,
+        particles: &Particles<D>,
+        body_force: &[SVector<f64, D>],
+        grid: &mut GridState<D>,
+    ) -> Result<FitStats, Divergence> {
+        match self {
+            Transfer::Shepard => {
+                particles_to_grid(stencils, particles, body_force, grid);
+                Ok(FitStats::default())
+            }
+            Transfer::Quadrature(q) => q
+                .map_to_grid(particles, body_force, grid)
+                .map_err(|e| Divergence::Reconstruction(e.to_string())),
+        }
+    }
+
+    /// The nodal velocity rebuilt from the particle velocities `v` with this step's
+    /// weights (MUSL's v_i^L): mass-weighted for Shepard, the velocity fit otherwise.
+    pub fn remap_velocity(
+        &self,
+        stencils: &Stencils<D>,
+        particles: &Particles<D>,
+        grid: &GridState<D>,
+        out: &mut [SVector<f64, D>],
+    ) {
+        match self {
+            Transfer::Shepard => {
+                out.fill(SVector::zeros());
+                for p in 0..particles.len() {
+                    let mv = particles.v[p] * particles.mass[p];
+                    for (i, w, _) in stencils.of(p) {
+                        out[i] += mv * w;
+                    }
+                }
+                for (v, &m) in out.iter_mut().zip(&grid.mass) {
+                    *v = if m > grid.empty_mass {
+                        *v / m
+                    } else {
+                        SVector::zeros()
+                    };
+                }
+            }
+            Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
+        }
+    }
+}
