@@ -3,8 +3,6 @@
 
 use std::fmt;
 
-use nalgebra::SVector;
-
 /// A 1D weight w(r), r = |x - x_p| / (scale h), in B-spline form.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Weight {
@@ -69,15 +67,6 @@ impl Kernel {
     pub fn radius_cells(&self) -> f64 {
         self.weight.radius() * self.scale
     }
-
-    /// Tensor-product weight of the offset `d`, given in units of h.
-    #[inline]
-    pub fn eval<const D: usize>(&self, d: &SVector<f64, D>) -> f64 {
-        let inv = 1.0 / self.scale;
-        d.iter()
-            .map(|&dk| self.weight.eval(dk.abs() * inv))
-            .product()
-    }
 }
 
 impl fmt::Display for Weight {
@@ -132,14 +121,11 @@ mod tests {
     }
 
     #[test]
-    fn kernel_scales_the_support_and_is_a_tensor_product() {
+    fn kernel_scales_the_support() {
         let k = Kernel {
             weight: Weight::QuadraticSpline,
             scale: 2.0,
         };
         assert_eq!(k.radius_cells(), 3.0);
-        let d = SVector::<f64, 2>::new(0.4, -1.7);
-        let expected = Weight::QuadraticSpline.eval(0.2) * Weight::QuadraticSpline.eval(0.85);
-        assert!((k.eval(&d) - expected).abs() < 1e-15);
     }
 }

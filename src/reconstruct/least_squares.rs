@@ -156,7 +156,11 @@ impl<const D: usize> Reconstructor<D> {
         self.phi.resize(n, 0.0);
         self.moments.fill(0.0);
         let mut near = [[(0usize, 0.0f64); MAX_PER_AXIS]; D];
+        // The weight is a tensor product: its 1D factors are computed once per axis.
+        let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
         let mut count = [0usize; D];
+        let inv_scale = 1.0 / self.recipe.kernel.scale;
+        let weight = self.recipe.kernel.weight;
         let mut q = [0.0; MAX_TERMS];
         let t = self.terms;
         for (p, xp) in x.iter().enumerate() {
@@ -164,6 +168,9 @@ impl<const D: usize> Reconstructor<D> {
                 count[k] = self
                     .lattice
                     .near_on_axis(k, xp[k], self.radius, &mut near[k]);
+                for j in 0..count[k] {
+                    axis_weight[k][j] = weight.eval(near[k][j].1.abs() * inv_scale);
+                }
             }
             let base = p * self.stride;
             let total: usize = count.iter().product();
@@ -176,14 +183,16 @@ impl<const D: usize> Reconstructor<D> {
                 }
                 let mut rest = slot;
                 let mut e = 0;
+                let mut w = 1.0;
                 let mut d = SVector::<f64, D>::zeros();
                 for k in 0..D {
-                    let (i, dk) = near[k][rest % count[k]];
+                    let j = rest % count[k];
                     rest /= count[k];
+                    let (i, dk) = near[k][j];
                     e += i * self.lattice.stride(k);
                     d[k] = -dk;
+                    w *= axis_weight[k][j];
                 }
-                let w = self.recipe.kernel.eval(&d);
                 self.point[entry] = e as u32;
                 self.offset[entry] = d;
                 self.phi[entry] = w;
