@@ -140,8 +140,16 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
                     half,
                     &mut synced,
                 );
-                self.recorder
-                    .sample(s, t, &self.particles, &synced, self.problem.as_ref());
+                // In node order, so the total is the same on every run.
+                let grid_mass = self.nodes.mass.iter().sum();
+                self.recorder.sample(
+                    s,
+                    t,
+                    &self.particles,
+                    &synced,
+                    grid_mass,
+                    self.problem.as_ref(),
+                );
             }
             if s == steps {
                 break;
@@ -188,6 +196,7 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         };
         record.history = self.recorder.history;
         record.errors = self.recorder.errors;
+        record.conservation = self.recorder.conservation;
         record
     }
 }
@@ -227,5 +236,7 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         particles: ParticleTable::default(),
         history: Default::default(),
         errors: Default::default(),
+        conservation: Default::default(),
+        diagnostics: Default::default(),
     }
 }

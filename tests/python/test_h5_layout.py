@@ -1,11 +1,12 @@
 """Checks the run files under $MPMLAB_RESULTS against the HDF5 layout documented in the
-README ("HDF5 layout", schema_version 1), using h5py and numpy only.
+README ("HDF5 layout", schema_version 2), using h5py and numpy only.
 
 Besides names, types and shapes, it recomputes from the stored arrays:
   * the quadrature volumes  /errors/volume = volume0 * rho0 / density,
   * every l2_* and rms_* norm and the final-value attributes of /errors/norms,
   * the pointwise errors themselves, from /history and an independent implementation of
     the manufactured solutions of Gong (mms1d_gong, mms2d_gong) and Tran (mms1d_tran),
+  * the mass totals of /conservation against /particles/mass,
 so that the exact solution and the error definitions are checked by a second implementation.
 
 `make test` runs the reduced matrices in tests/matrices/ and points MPMLAB_RESULTS at them.
@@ -22,7 +23,7 @@ import numpy as np
 import pytest
 
 ENV = "MPMLAB_RESULTS"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 STR_ATTRS = (
     "run_id",
@@ -43,6 +44,9 @@ STATUSES = ("ok", "diverged", "failed")
 
 FIELDS = ("displacement", "velocity", "stress", "density")
 NORMS = ("l2", "rms")
+
+MASS_UNITS = "kg"
+DIAGNOSTICS = ("reconstructions", "rank_deficient")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
 
@@ -270,6 +274,9 @@ def _expected_shapes(run):
         "/history/density": (n_t, n_p),
         "/errors/time": (n_e,),
         "/errors/volume": (n_e, n_p),
+        "/conservation/time": (n_t,),
+        "/conservation/particle_mass": (n_t,),
+        "/conservation/grid_mass": (n_t,),
     }
     for field in FIELDS:
         shapes[f"/errors/{field}"] = (n_e, n_p)
@@ -344,6 +351,51 @@ def test_particles(run):
         np.testing.assert_allclose(vol0.sum(), volume, rtol=RTOL_STORED, err_msg="volume0")
         # The history starts in the reference configuration.
         np.testing.assert_array_equal(run.ds("/history/x")[0], X)
+
+
+# --------------------------------------------------------------------------------------------
+# Mass totals and reconstruction counters
+
+
+def test_conservation(run):
+    run.require_data()
+    np.testing.assert_array_equal(
+        run.ds("/conservation/time"), run.ds("/history/time"),
+        err_msg="/conservation/time differs from /history/time",
+    )
+    assert run.units["/conservation/time"] == "s"
+    for name in ("particle_mass", "grid_mass"):
+        assert run.units[f"/conservation/{name}"] == MASS_UNITS, f"/conservation/{name} units"
+    particle = run.ds("/conservation/particle_mass")
+    grid = run.ds("/conservation/grid_mass")
+    # Particle masses never change, and the total is summed in the same order every time.
+    np.testing.assert_array_equal(particle, particle[0], err_msg="particle mass is not constant")
+    np.testing.assert_allclose(
+        particle, run.ds("/particles/mass").sum(), rtol=RTOL_STORED,
+        err_msg="/conservation/particle_mass != sum of /particles/mass",
+    )
+    assert np.all(np.isfinite(grid)) and np.all(grid > 0), "grid mass is not positive"
+    if run.attrs["method"] == "mpm":
+        # The original MPM lumps each particle's mass onto nodes with weights summing to one.
+        np.testing.assert_allclose(
+            grid, particle, rtol=1e-12, atol=0, err_msg="mpm grid mass != particle mass"
+        )
+
+
+def test_diagnostics(run):
+    counters = run.group("/diagnostics")
+    for name in DIAGNOSTICS:
+        assert name in counters, f"/diagnostics has no attribute {name}"
+        v = counters[name]
+        assert isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)), (
+            f"/diagnostics {name} is not an integer: {v!r}"
+        )
+        assert v >= 0, f"/diagnostics {name} = {v} < 0"
+    assert counters["rank_deficient"] <= counters["reconstructions"]
+    if run.attrs["method"] == "mpm":
+        assert counters["reconstructions"] == 0 and counters["rank_deficient"] == 0, (
+            "the original MPM makes no least-squares fits"
+        )
 
 
 # --------------------------------------------------------------------------------------------
