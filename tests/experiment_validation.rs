@@ -212,6 +212,39 @@ fn unstable_cfl_is_reported_at_its_value_with_the_run() {
     assert!(e.message.contains("cfl=0.95"), "{e}");
 }
 
+/// A small matrix of Tran's bar, for its own parameter checks.
+const TRAN: &str = "\
+name: tran
+benchmark: mms1d_tran
+params: {method: mpm, ppc: 3, A: 0.001, dt: 1.0e-5}
+matrix:
+  cells: [8, 16, 32]
+";
+
+#[test]
+fn tran_amplitude_that_inverts_the_bar_is_named() {
+    let e = error(&TRAN.replace("A: 0.001", "A: 0.2"));
+    check(&e, 3, 34, "params.A", "|2 pi A / L| = 1.2566 >= 1", &[]);
+    // The default A = 0.1 on a bar of half a metre: reported at the benchmark.
+    let e = error(&TRAN.replace("A: 0.001", "L: 0.5"));
+    check(
+        &e,
+        2,
+        12,
+        "params.A",
+        "the default A = 0.1 of mms1d_tran",
+        &[],
+    );
+}
+
+#[test]
+fn tran_unstable_time_step_is_reported_with_the_run() {
+    let e = error(&TRAN.replace("dt: 1.0e-5", "dt: 5.0e-4"));
+    check(&e, 3, 45, "params.dt", "unstable", &[]);
+    assert!(e.message.contains("cells=32"), "{e}");
+    assert!(e.message.contains("Courant number"), "{e}");
+}
+
 #[test]
 fn missing_required_parameter_is_named() {
     let e = error(&edited("ppc: 2, ", ""));

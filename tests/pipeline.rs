@@ -32,7 +32,13 @@ fn options(out: &Path, jobs: usize, force: bool) -> RunOptions {
 fn datasets(path: &Path) -> Vec<(String, Vec<f64>)> {
     let file = hdf5::File::open(path).unwrap();
     let mut out = Vec::new();
-    for group in ["particles", "history", "errors", "errors/norms"] {
+    for group in [
+        "particles",
+        "history",
+        "errors",
+        "errors/norms",
+        "conservation",
+    ] {
         let g = file.group(group).unwrap();
         for name in g.member_names().unwrap() {
             if let Ok(ds) = g.dataset(&name) {

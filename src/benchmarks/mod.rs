@@ -2,13 +2,16 @@
 //! exact solution. A benchmark knows nothing of how a method maps data.
 
 mod mms_gong;
+mod mms_tran;
+mod sine_mms;
 
 use nalgebra::{SMatrix, SVector};
 
 use crate::material::NeoHookean;
 use crate::params::{ParamError, Params};
 
-pub use mms_gong::{thesis_params, GongMms};
+pub use mms_gong::{gong_mms, thesis_params};
+pub use sine_mms::SineMms;
 
 /// The kind of value a parameter takes; checked by the experiment layer before a run starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,7 +51,7 @@ pub struct BenchmarkInfo {
     pub check: fn(&Params) -> Result<(), ParamError>,
 }
 
-const CATALOG: &[BenchmarkInfo] = &[mms_gong::INFO_1D, mms_gong::INFO_2D];
+const CATALOG: &[BenchmarkInfo] = &[mms_gong::INFO_1D, mms_gong::INFO_2D, mms_tran::INFO];
 
 pub fn catalog() -> &'static [BenchmarkInfo] {
     CATALOG
@@ -112,8 +115,9 @@ pub enum AnyProblem {
 /// Builds the named benchmark from validated parameters.
 pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
     match name {
-        "mms1d_gong" => Ok(AnyProblem::D1(Box::new(GongMms::<1>::from_params(params)?))),
-        "mms2d_gong" => Ok(AnyProblem::D2(Box::new(GongMms::<2>::from_params(params)?))),
+        "mms1d_gong" => Ok(AnyProblem::D1(Box::new(gong_mms::<1>(params)?))),
+        "mms2d_gong" => Ok(AnyProblem::D2(Box::new(gong_mms::<2>(params)?))),
+        "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
         other => Err(ParamError::new(
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use crate::params::Params;
 
 /// Bumped whenever a name or shape below changes meaning.
-pub const SCHEMA_VERSION: i64 = 1;
+pub const SCHEMA_VERSION: i64 = 2;
 
 /// The error fields, in the order they are written.
 pub const ERROR_FIELDS: [&str; 4] = ["displacement", "velocity", "stress", "density"];
@@ -70,5 +70,5 @@ mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
 pub use reader::read_summary;
-pub use record::{Errors, History, ParticleTable, RunRecord};
+pub use record::{Conservation, Diagnostics, Errors, History, ParticleTable, RunRecord};
 pub use writer::write_hdf5;

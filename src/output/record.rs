@@ -22,6 +22,8 @@ pub struct RunRecord {
     pub particles: ParticleTable,
     pub history: History,
     pub errors: Errors,
+    pub conservation: Conservation,
+    pub diagnostics: Diagnostics,
 }
 
 /// `/particles`: reference positions (Np x D), masses and initial volumes.
@@ -68,4 +70,24 @@ pub struct Errors {
     pub l2: [Vec<f64>; 4],
     /// Per field: Nt values of sqrt(sum_p |e_p|^2 / Np).
     pub rms: [Vec<f64>; 4],
+}
+
+/// `/conservation`: mass totals at the history samples (the times are `/history/time`).
+/// Methods that reconstruct density at quadrature points do not carry the particle mass to
+/// the grid exactly; these totals show by how much.
+#[derive(Clone, Debug, Default)]
+pub struct Conservation {
+    /// Nt sums of the particle masses.
+    pub particle_mass: Vec<f64>,
+    /// Nt sums of the lumped nodal masses assembled at the sampled step.
+    pub grid_mass: Vec<f64>,
+}
+
+/// `/diagnostics`: how the local least-squares fits of a run went.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Diagnostics {
+    /// Local least-squares fits made during the run.
+    pub reconstructions: usize,
+    /// Fits whose moment matrix lost rank.
+    pub rank_deficient: usize,
 }

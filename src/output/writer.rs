@@ -87,6 +87,22 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
             attr_f64(&norms, &name, values.last().copied().unwrap_or(f64::NAN))?;
         }
     }
+
+    let conservation = file.create_group("conservation")?;
+    dataset(&conservation, "time", &r.history.time, &[nt], "s")?;
+    for (name, values) in [
+        ("particle_mass", &r.conservation.particle_mass),
+        ("grid_mass", &r.conservation.grid_mass),
+    ] {
+        dataset(&conservation, name, values, &[nt], "kg")?;
+    }
+    let diagnostics = file.create_group("diagnostics")?;
+    for (name, value) in [
+        ("reconstructions", r.diagnostics.reconstructions),
+        ("rank_deficient", r.diagnostics.rank_deficient),
+    ] {
+        attr_i64(&diagnostics, name, value as i64)?;
+    }
     file.flush()?;
     Ok(())
 }

@@ -35,8 +35,8 @@ pub struct Recipe {
 /// rank (IMLS dropped a polynomial).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FitStats {
-    pub fits: u64,
-    pub rank_deficient: u64,
+    pub fits: usize,
+    pub rank_deficient: usize,
 }
 
 impl AddAssign for FitStats {

@@ -109,7 +109,7 @@ impl fmt::Display for QuadratureRecipe {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{thesis_params, GongMms, Problem};
+    use crate::benchmarks::{gong_mms, thesis_params, Problem};
     use crate::methods;
     use crate::shape::LinearHat;
 
@@ -127,7 +127,7 @@ mod tests {
     /// is the particle mass and the body force its resultant, to round-off. Internal forces
     /// cancel for any stress because sum_i grad N_i = 0 at every quadrature point.
     fn check_balance<const D: usize>() {
-        let prob = GongMms::<D>::from_params(&thesis_params(0.1, 6, 3)).unwrap();
+        let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
         let mut particles = Particles::seed(&prob, &grid);
         let mut rng = crate::testing::Lcg::new(99);

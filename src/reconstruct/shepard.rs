@@ -40,12 +40,12 @@ pub fn particles_to_grid<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{thesis_params, GongMms, Problem};
+    use crate::benchmarks::{gong_mms, thesis_params, Problem, SineMms};
     use crate::shape::{Grid, LinearHat, Shape};
     use nalgebra::SMatrix;
 
-    fn problem<const D: usize>() -> GongMms<D> {
-        GongMms::from_params(&thesis_params(0.1, 6, 3)).unwrap()
+    fn problem<const D: usize>() -> SineMms<D> {
+        gong_mms(&thesis_params(0.1, 6, 3)).unwrap()
     }
 
     /// The transfer conserves mass and momentum and its internal forces sum to zero, to

@@ -11,7 +11,7 @@ use crate::benchmarks::{self, AnyProblem, Problem};
 use crate::experiment::RunSpec;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
-use crate::output::{ParticleTable, RunRecord, RunStatus};
+use crate::output::{Diagnostics, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
 use crate::reconstruct::{FitStats, GridState};
 use crate::shape::{Grid, LinearHat, Shape, Stencils};
@@ -157,8 +157,16 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
                 } else {
                     &self.particles.v
                 };
-                self.recorder
-                    .sample(s, t, &self.particles, velocity, self.problem.as_ref());
+                // In node order, so the total is the same on every run.
+                let grid_mass = self.nodes.mass.iter().sum();
+                self.recorder.sample(
+                    s,
+                    t,
+                    &self.particles,
+                    velocity,
+                    grid_mass,
+                    self.problem.as_ref(),
+                );
             }
             if s == steps {
                 break;
@@ -229,6 +237,11 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         };
         record.history = self.recorder.history;
         record.errors = self.recorder.errors;
+        record.conservation = self.recorder.conservation;
+        record.diagnostics = Diagnostics {
+            reconstructions: self.fits.fits,
+            rank_deficient: self.fits.rank_deficient,
+        };
         record
     }
 }
@@ -268,5 +281,7 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         particles: ParticleTable::default(),
         history: Default::default(),
         errors: Default::default(),
+        conservation: Default::default(),
+        diagnostics: Default::default(),
     }
 }

@@ -1,13 +1,15 @@
 use nalgebra::SVector;
 
 use crate::benchmarks::Problem;
-use crate::output::{Errors, History};
+use crate::output::{Conservation, Errors, History};
 use crate::particles::Particles;
 
-/// Appends sampled particle states and their errors against the exact solution.
+/// Appends sampled particle states, their errors against the exact solution and the mass
+/// totals.
 pub struct Recorder {
     pub history: History,
     pub errors: Errors,
+    pub conservation: Conservation,
 }
 
 impl Recorder {
@@ -15,16 +17,19 @@ impl Recorder {
         Recorder {
             history: History::default(),
             errors: Errors::default(),
+            conservation: Conservation::default(),
         }
     }
 
-    /// Records the state at step `step`, time `t`, with `velocity` synchronised to `t`.
+    /// Records the state at step `step`, time `t`, with `velocity` synchronised to `t`, and
+    /// `grid_mass`, the total nodal mass the transfer of that step assembled.
     pub fn sample<const D: usize>(
         &mut self,
         step: usize,
         t: f64,
         particles: &Particles<D>,
         velocity: &[SVector<f64, D>],
+        grid_mass: f64,
         problem: &dyn Problem<D>,
     ) {
         let h = &mut self.history;
@@ -39,6 +44,10 @@ impl Recorder {
             h.density.push(rho0 / particles.j[p]);
         }
         self.sample_errors(t, particles, velocity, problem);
+        // Summed in particle order, so the total is the same on every run.
+        let particle_mass = particles.mass.iter().sum();
+        self.conservation.particle_mass.push(particle_mass);
+        self.conservation.grid_mass.push(grid_mass);
     }
 
     fn sample_errors<const D: usize>(

@@ -1,11 +1,12 @@
 """Checks the run files under $MPMLAB_RESULTS against the HDF5 layout documented in the
-README ("HDF5 layout", schema_version 1), using h5py and numpy only.
+README ("HDF5 layout", schema_version 2), using h5py and numpy only.
 
 Besides names, types and shapes, it recomputes from the stored arrays:
   * the quadrature volumes  /errors/volume = volume0 * rho0 / density,
   * every l2_* and rms_* norm and the final-value attributes of /errors/norms,
   * the pointwise errors themselves, from /history and an independent implementation of
-    Gong's manufactured solutions (mms1d_gong, mms2d_gong),
+    the manufactured solutions of Gong (mms1d_gong, mms2d_gong) and Tran (mms1d_tran),
+  * the mass totals of /conservation against /particles/mass,
 so that the exact solution and the error definitions are checked by a second implementation.
 
 `make test` runs the reduced matrices in tests/matrices/ and points MPMLAB_RESULTS at them.
@@ -15,13 +16,14 @@ Without the variable, or with no *.h5 file under it, the suite fails (it never p
 import os
 import re
 from pathlib import Path
+from typing import Callable, NamedTuple
 
 import h5py
 import numpy as np
 import pytest
 
 ENV = "MPMLAB_RESULTS"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 STR_ATTRS = (
     "run_id",
@@ -43,9 +45,8 @@ STATUSES = ("ok", "diverged", "failed")
 FIELDS = ("displacement", "velocity", "stress", "density")
 NORMS = ("l2", "rms")
 
-# Benchmarks with a known exact solution on the unit interval / square.
-GONG = {"mms1d_gong": 1, "mms2d_gong": 2}
-GONG_PARAMS = ("G", "E", "nu", "rho0", "t_end", "cfl", "ppc", "cells")
+MASS_UNITS = "kg"
+DIAGNOSTICS = ("reconstructions", "rank_deficient")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
 
@@ -218,8 +219,9 @@ def test_identity(run):
         assert run.path.parent.parent.name == a["experiment"], (
             "run files live in <out>/<experiment>/runs/"
         )
-    if a["benchmark"] in GONG:
-        assert a["dim"] == GONG[a["benchmark"]], f"{a['benchmark']} has dim {GONG[a['benchmark']]}"
+    bench = BENCHMARKS.get(a["benchmark"])
+    if bench is not None:
+        assert a["dim"] == bench.dim, f"{a['benchmark']} has dim {bench.dim}"
 
 
 def test_params_and_matrix(run):
@@ -227,15 +229,15 @@ def test_params_and_matrix(run):
     params = run.group("/params")
     matrix = run.group("/matrix")
     assert params, "/params has no attributes"
-    if a["benchmark"] in GONG:
-        for key in GONG_PARAMS:
+    bench = BENCHMARKS.get(a["benchmark"])
+    if bench is not None:
+        for key in bench.params + ("rho0", "t_end", "ppc", "cells"):
             run.param(key)
         assert run.param("cells") == a["cells"]
         assert run.param("ppc") == a["ppc"]
         np.testing.assert_allclose(run.param("t_end"), a["t_end"], rtol=1e-15)
-        np.testing.assert_allclose(a["h"], 1.0 / a["cells"], rtol=RTOL_STORED)
-        c = np.sqrt(run.param("E") / run.param("rho0"))
-        assert a["dt"] <= run.param("cfl") * a["h"] / c * (1 + 1e-12), "dt exceeds cfl h / c"
+        np.testing.assert_allclose(a["h"], bench.length(run) / a["cells"], rtol=RTOL_STORED)
+        assert a["dt"] <= bench.max_dt(run) * (1 + 1e-9), "dt exceeds the requested step"
     for key, value in matrix.items():
         assert np.asarray(value).shape == (), f"/matrix/{key} is not a scalar"
         if key == "method":
@@ -272,6 +274,9 @@ def _expected_shapes(run):
         "/history/density": (n_t, n_p),
         "/errors/time": (n_e,),
         "/errors/volume": (n_e, n_p),
+        "/conservation/time": (n_t,),
+        "/conservation/particle_mass": (n_t,),
+        "/conservation/grid_mass": (n_t,),
     }
     for field in FIELDS:
         shapes[f"/errors/{field}"] = (n_e, n_p)
@@ -298,7 +303,7 @@ def test_datasets_shapes_types_units(run):
     n_p = shapes["/particles/X"][0]
     assert n_p >= 1
     assert shapes["/history/time"][0] >= 2, "history holds at least t = 0 and the final time"
-    if a["benchmark"] in GONG:
+    if a["benchmark"] in BENCHMARKS:
         assert n_p == (a["cells"] * a["ppc"]) ** a["dim"], "Np != (cells * ppc)^dim"
 
 
@@ -335,12 +340,62 @@ def test_particles(run):
     mass = run.ds("/particles/mass")
     vol0 = run.ds("/particles/volume0")
     assert np.all(mass > 0) and np.all(vol0 > 0)
-    if run.attrs["benchmark"] in GONG:
-        assert np.all((X > 0) & (X < 1)), "reference positions outside the unit domain"
-        np.testing.assert_allclose(mass.sum(), run.param("rho0"), rtol=RTOL_STORED, err_msg="mass")
-        np.testing.assert_allclose(vol0.sum(), 1.0, rtol=RTOL_STORED, err_msg="volume0")
+    bench = BENCHMARKS.get(run.attrs["benchmark"])
+    if bench is not None:
+        length = bench.length(run)
+        volume = length ** bench.dim
+        assert np.all((X > 0) & (X < length)), "reference positions outside the domain"
+        np.testing.assert_allclose(
+            mass.sum(), run.param("rho0") * volume, rtol=RTOL_STORED, err_msg="mass"
+        )
+        np.testing.assert_allclose(vol0.sum(), volume, rtol=RTOL_STORED, err_msg="volume0")
         # The history starts in the reference configuration.
         np.testing.assert_array_equal(run.ds("/history/x")[0], X)
+
+
+# --------------------------------------------------------------------------------------------
+# Mass totals and reconstruction counters
+
+
+def test_conservation(run):
+    run.require_data()
+    np.testing.assert_array_equal(
+        run.ds("/conservation/time"), run.ds("/history/time"),
+        err_msg="/conservation/time differs from /history/time",
+    )
+    assert run.units["/conservation/time"] == "s"
+    for name in ("particle_mass", "grid_mass"):
+        assert run.units[f"/conservation/{name}"] == MASS_UNITS, f"/conservation/{name} units"
+    particle = run.ds("/conservation/particle_mass")
+    grid = run.ds("/conservation/grid_mass")
+    # Particle masses never change, and the total is summed in the same order every time.
+    np.testing.assert_array_equal(particle, particle[0], err_msg="particle mass is not constant")
+    np.testing.assert_allclose(
+        particle, run.ds("/particles/mass").sum(), rtol=RTOL_STORED,
+        err_msg="/conservation/particle_mass != sum of /particles/mass",
+    )
+    assert np.all(np.isfinite(grid)) and np.all(grid > 0), "grid mass is not positive"
+    if run.attrs["method"] == "mpm":
+        # The original MPM lumps each particle's mass onto nodes with weights summing to one.
+        np.testing.assert_allclose(
+            grid, particle, rtol=1e-12, atol=0, err_msg="mpm grid mass != particle mass"
+        )
+
+
+def test_diagnostics(run):
+    counters = run.group("/diagnostics")
+    for name in DIAGNOSTICS:
+        assert name in counters, f"/diagnostics has no attribute {name}"
+        v = counters[name]
+        assert isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)), (
+            f"/diagnostics {name} is not an integer: {v!r}"
+        )
+        assert v >= 0, f"/diagnostics {name} = {v} < 0"
+    assert counters["rank_deficient"] <= counters["reconstructions"]
+    if run.attrs["method"] == "mpm":
+        assert counters["reconstructions"] == 0 and counters["rank_deficient"] == 0, (
+            "the original MPM makes no least-squares fits"
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -389,33 +444,86 @@ def test_norms(run):
 
 
 # --------------------------------------------------------------------------------------------
-# Second implementation of Gong's manufactured solution
+# Second implementation of the manufactured solutions
 
 
-def gong_exact(X, t, G, E, nu, rho0):
-    """Exact displacement, velocity, Cauchy stress and density of the material points that
-    started at X (Np, D), at times t (Nt,). Returns arrays shaped (Nt, Np, ...).
+class Wave(NamedTuple):
+    """U_k = amplitude sin(k X_k) sin(omega t) in each direction, neo-Hookean (lam, mu)."""
 
-    U_k = G sin(pi X_k) sin(c pi t), c = sqrt(E / rho0), F = diag(1 + pi G cos(pi X_k) sin(c pi t)),
-    J = prod F_kk, rho = rho0 / J, sigma = (lambda ln J I + mu (F F^T - I)) / J.
-    """
+    amplitude: float
+    k: float
+    omega: float
+    lam: float
+    mu: float
+    rho0: float
+
+
+def gong_wave(run):
+    """Gong 2015 sec 4.5: G sin(pi X) sin(c pi t), c = sqrt(E / rho0), Lame from E and nu."""
+    G, E, nu, rho0 = (run.param(k) for k in ("G", "E", "nu", "rho0"))
     c = np.sqrt(E / rho0)
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
-    st = np.sin(c * np.pi * t)[:, None, None]
-    ct = np.cos(c * np.pi * t)[:, None, None]
-    sx = np.sin(np.pi * X)[None]
-    cx = np.cos(np.pi * X)[None]
-    u = G * sx * st
-    v = c * np.pi * G * sx * ct
-    f = 1 + np.pi * G * cx * st  # diagonal of F, (Nt, Np, D)
+    return Wave(G, np.pi, c * np.pi, lam, mu, rho0)
+
+
+def tran_wave(run):
+    """Tran et al. 2019 eq 44: A sin(2 pi X / L) sin(c pi t / L), c = sqrt(E / rho0) with
+    E = mu (3 lambda + 2 mu) / (lambda + mu)."""
+    A, lam, mu, rho0, L = (run.param(k) for k in ("A", "lambda", "mu", "rho0", "L"))
+    E = mu * (3 * lam + 2 * mu) / (lam + mu)
+    c = np.sqrt(E / rho0)
+    return Wave(A, 2 * np.pi / L, c * np.pi / L, lam, mu, rho0)
+
+
+def gong_max_dt(run):
+    a = run.attrs
+    return run.param("cfl") * a["h"] * np.sqrt(run.param("rho0") / run.param("E"))
+
+
+class Benchmark(NamedTuple):
+    dim: int
+    params: tuple  # parameters besides rho0, t_end, ppc and cells
+    length: Callable  # run -> edge of the domain [0, L]^dim
+    wave: Callable  # run -> Wave
+    max_dt: Callable  # run -> the step the time step may not exceed
+
+
+GONG_PARAMS = ("G", "E", "nu", "cfl")
+BENCHMARKS = {
+    "mms1d_gong": Benchmark(1, GONG_PARAMS, lambda run: 1.0, gong_wave, gong_max_dt),
+    "mms2d_gong": Benchmark(2, GONG_PARAMS, lambda run: 1.0, gong_wave, gong_max_dt),
+    "mms1d_tran": Benchmark(
+        1,
+        ("A", "mu", "lambda", "L", "dt"),
+        lambda run: run.param("L"),
+        tran_wave,
+        lambda run: run.param("dt"),
+    ),
+}
+
+
+def sine_exact(X, t, w):
+    """Exact displacement, velocity, Cauchy stress and density of the material points that
+    started at X (Np, D), at times t (Nt,). Returns arrays shaped (Nt, Np, ...).
+
+    F = diag(1 + k A cos(k X_k) sin(omega t)), J = prod F_kk, rho = rho0 / J,
+    sigma = (lambda ln J I + mu (F F^T - I)) / J.
+    """
+    st = np.sin(w.omega * t)[:, None, None]
+    ct = np.cos(w.omega * t)[:, None, None]
+    sx = np.sin(w.k * X)[None]
+    cx = np.cos(w.k * X)[None]
+    u = w.amplitude * sx * st
+    v = w.omega * w.amplitude * sx * ct
+    f = 1 + w.k * w.amplitude * cx * st  # diagonal of F, (Nt, Np, D)
     j = np.prod(f, axis=-1)
     d = X.shape[1]
     sigma = np.zeros(f.shape + (d,))
-    diag = (lam * np.log(j)[..., None] + mu * (f**2 - 1)) / j[..., None]
+    diag = (w.lam * np.log(j)[..., None] + w.mu * (f**2 - 1)) / j[..., None]
     for k in range(d):
         sigma[..., k, k] = diag[..., k]
-    return u, v, sigma, rho0 / j
+    return u, v, sigma, w.rho0 / j
 
 
 def _check_pointwise(name, stored, recomputed, numerical, exact):
@@ -430,12 +538,11 @@ def _check_pointwise(name, stored, recomputed, numerical, exact):
 def test_exact_errors(run):
     run.require_data()
     benchmark = run.attrs["benchmark"]
-    if benchmark not in GONG:
+    if benchmark not in BENCHMARKS:
         pytest.skip(f"no independent exact solution for {benchmark}")
-    G, E, nu, rho0 = (run.param(k) for k in ("G", "E", "nu", "rho0"))
     X = run.ds("/particles/X")
     t = run.ds("/history/time")
-    u, v, sigma, rho = gong_exact(X, t, G, E, nu, rho0)
+    u, v, sigma, rho = sine_exact(X, t, BENCHMARKS[benchmark].wave(run))
 
     disp = run.ds("/history/x") - X[None]
     vel = run.ds("/history/v")
