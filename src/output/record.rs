@@ -1,4 +1,4 @@
-use super::RunStatus;
+use super::{ReconstructionRecord, RunStatus};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
@@ -22,6 +22,8 @@ pub struct RunRecord {
     pub particles: ParticleTable,
     pub history: History,
     pub errors: Errors,
+    /// Set for the runs of reconstruction benchmarks, which have no particles or history.
+    pub reconstruction: Option<ReconstructionRecord>,
 }
 
 /// `/particles`: reference positions (Np x D), masses and initial volumes.

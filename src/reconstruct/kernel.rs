@@ -18,6 +18,26 @@ pub enum Weight {
 }
 
 impl Weight {
+    pub const ALL: [Weight; 3] = [Weight::Hat, Weight::QuadraticSpline, Weight::CubicSpline];
+    /// The names experiment files use, in the order of `ALL`.
+    pub const NAMES: [&'static str; 3] = [
+        Weight::Hat.name(),
+        Weight::QuadraticSpline.name(),
+        Weight::CubicSpline.name(),
+    ];
+
+    pub const fn name(self) -> &'static str {
+        match self {
+            Weight::Hat => "hat",
+            Weight::QuadraticSpline => "quadratic",
+            Weight::CubicSpline => "cubic",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Weight> {
+        Weight::ALL.into_iter().find(|w| w.name() == name)
+    }
+
     /// Support radius in units of the support length.
     pub fn radius(self) -> f64 {
         match self {
@@ -82,11 +102,7 @@ impl Kernel {
 
 impl fmt::Display for Weight {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Weight::Hat => "hat",
-            Weight::QuadraticSpline => "quadratic",
-            Weight::CubicSpline => "cubic",
-        })
+        f.write_str(self.name())
     }
 }
 
