@@ -33,7 +33,8 @@ RESULTS ?= results
 JOBS ?=
 FORCE ?=
 
-BIN := target/release/mpmlab
+# cargo builds into $CARGO_TARGET_DIR when it is set.
+BIN := $(or $(CARGO_TARGET_DIR),target)/release/mpmlab
 VENV := .venv
 VENV_PY := $(VENV)/bin/python
 PY_REQUIREMENTS := tests/python/requirements.txt

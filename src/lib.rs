@@ -15,9 +15,9 @@ pub mod output;
 pub mod params;
 pub mod particles;
 pub mod reconstruct;
+pub mod reconstruction_methods;
 pub mod report;
+pub mod rng;
 pub mod runner;
 pub mod shape;
 pub mod solver;
-#[cfg(test)]
-mod testing;

@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 
 use mpmlab::collect::collect;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions};
-use mpmlab::{benchmarks, experiment, methods, report};
+use mpmlab::{benchmarks, experiment, methods, reconstruction_methods, report};
 
 /// mpmlab: run Material Point Method experiment matrices and report their convergence.
 #[derive(Parser)]
@@ -45,7 +45,7 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
-    /// List the method presets and what they are composed of.
+    /// List the method presets and what they are composed of, and the reconstruction methods.
     ListMethods,
     /// List the benchmarks and their parameters.
     ListBenchmarks,
@@ -155,25 +155,46 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
 }
 
 fn list_methods() {
+    println!("Simulation methods (benchmarks of kind simulation):");
     for preset in methods::presets() {
         println!(
-            "{:<10} {}  [{}]",
+            "{:<15} {}  [{}]",
             preset.name, preset.description, preset.source
         );
-        println!("{:<10} {}", "", preset.method);
+        println!("{:<15} {}", "", preset.method);
+    }
+    println!("\nReconstruction methods (reconstruction benchmarks; the weight is a parameter):");
+    for m in reconstruction_methods::methods() {
+        println!("{:<15} {}  [{}]", m.name, m.description, m.source);
+        println!("{:<15} degree={} solver={}", "", m.degree.value(), m.solver);
     }
 }
 
 fn list_benchmarks() {
     for b in benchmarks::catalog() {
-        println!("{} ({}D) - {} [{}]", b.name, b.dim, b.description, b.source);
+        println!(
+            "{} ({}D, {}) - {} [{}]",
+            b.name,
+            b.dim,
+            benchmarks::kind(b),
+            b.description,
+            b.source
+        );
         for p in b.params {
             let default = match p.default {
                 benchmarks::ParamDefault::Required => "required".to_string(),
                 benchmarks::ParamDefault::Int(i) => format!("default {i}"),
                 benchmarks::ParamDefault::Float(x) => format!("default {x:?}"),
+                benchmarks::ParamDefault::Text(s) => format!("default {s}"),
             };
-            println!("  {:<6} {:<9} [{}] {}", p.key, default, p.unit, p.doc);
+            let choices = match p.kind {
+                benchmarks::ParamKind::Choice(names) => format!(" (one of: {})", names.join(", ")),
+                _ => String::new(),
+            };
+            println!(
+                "  {:<8} {:<17} [{}] {}{choices}",
+                p.key, default, p.unit, p.doc
+            );
         }
     }
 }

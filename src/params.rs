@@ -11,6 +11,8 @@ pub enum ParamValue {
     Int(i64),
     Float(f64),
     Str(String),
+    /// Finite reals, e.g. the coordinates of a given point set.
+    List(Vec<f64>),
 }
 
 impl ParamValue {
@@ -19,7 +21,7 @@ impl ParamValue {
         match self {
             ParamValue::Int(i) => Some(*i as f64),
             ParamValue::Float(x) => Some(*x),
-            ParamValue::Str(_) => None,
+            _ => None,
         }
     }
 
@@ -37,25 +39,37 @@ impl ParamValue {
         }
     }
 
+    pub fn as_list(&self) -> Option<&[f64]> {
+        match self {
+            ParamValue::List(values) => Some(values),
+            _ => None,
+        }
+    }
+
     /// Name of the value's type, for error messages.
     pub fn type_name(&self) -> &'static str {
         match self {
             ParamValue::Int(_) => "integer",
             ParamValue::Float(_) => "number",
             ParamValue::Str(_) => "string",
+            ParamValue::List(_) => "list",
         }
     }
 }
 
 /// Canonical text: integers in decimal, floats in Rust's shortest round-trip form
-/// (always with a `.` or exponent), strings verbatim. Run ids hash this text, so it must
-/// never change for a given value.
+/// (always with a `.` or exponent), strings verbatim, lists as `[a, b]` of such floats. Run
+/// ids hash this text, so it must never change for a given value.
 impl fmt::Display for ParamValue {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ParamValue::Int(i) => write!(f, "{i}"),
             ParamValue::Float(x) => write!(f, "{x:?}"),
             ParamValue::Str(s) => f.write_str(s),
+            ParamValue::List(values) => {
+                let items: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
+                write!(f, "[{}]", items.join(", "))
+            }
         }
     }
 }
@@ -93,6 +107,20 @@ pub fn get_f64(params: &Params, key: &str) -> Result<f64, ParamError> {
         .get(key)
         .and_then(ParamValue::as_f64)
         .ok_or_else(|| ParamError::new(key, "missing or not a number"))
+}
+
+pub fn get_str<'a>(params: &'a Params, key: &str) -> Result<&'a str, ParamError> {
+    params
+        .get(key)
+        .and_then(ParamValue::as_str)
+        .ok_or_else(|| ParamError::new(key, "missing or not text"))
+}
+
+pub fn get_list<'a>(params: &'a Params, key: &str) -> Result<&'a [f64], ParamError> {
+    params
+        .get(key)
+        .and_then(ParamValue::as_list)
+        .ok_or_else(|| ParamError::new(key, "missing or not a list of numbers"))
 }
 
 pub fn get_usize(params: &Params, key: &str) -> Result<usize, ParamError> {

@@ -693,16 +693,19 @@ fn odd_documents_never_panic_and_errors_are_located() {
 
 #[test]
 fn every_scalar_replaced_by_odd_values_never_panics() {
-    let starts = VALID.char_indices().filter(|&(i, c)| {
-        let prev = VALID[..i].chars().last();
-        c.is_alphanumeric() && matches!(prev, Some(' ' | '[' | '{'))
-    });
-    for (start, _) in starts {
-        let end = VALID[start..]
-            .find([',', '}', ']', '\n'])
-            .map_or(VALID.len(), |n| start + n);
-        for value in ODD_VALUES {
-            assert_no_panic_and_located(&format!("{}{value}{}", &VALID[..start], &VALID[end..]));
+    for valid in [VALID, RECONSTRUCTION] {
+        let starts = valid.char_indices().filter(|&(i, c)| {
+            let prev = valid[..i].chars().last();
+            c.is_alphanumeric() && matches!(prev, Some(' ' | '[' | '{'))
+        });
+        for (start, _) in starts {
+            let end = valid[start..]
+                .find([',', '}', ']', '\n'])
+                .map_or(valid.len(), |n| start + n);
+            for value in ODD_VALUES {
+                let text = format!("{}{value}{}", &valid[..start], &valid[end..]);
+                assert_no_panic_and_located(&text);
+            }
         }
     }
 }
@@ -710,8 +713,13 @@ fn every_scalar_replaced_by_odd_values_never_panics() {
 #[test]
 fn random_splices_cuts_and_swaps_never_panic() {
     let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
-    for _ in 0..600 {
-        let mut text: Vec<char> = VALID.chars().collect();
+    for round in 0..1200 {
+        let valid = if round % 2 == 0 {
+            VALID
+        } else {
+            RECONSTRUCTION
+        };
+        let mut text: Vec<char> = valid.chars().collect();
         for _ in 0..1 + rng.below(3) {
             let at = rng.below(text.len() + 1);
             match rng.below(3) {
@@ -737,4 +745,269 @@ fn random_splices_cuts_and_swaps_never_panic() {
         }
         assert_no_panic_and_located(&text.iter().collect::<String>());
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reconstruction benchmarks: choices, point lists, matrix blocks, figure and table kinds.
+
+const RECONSTRUCTION: &str = "\
+name: recon
+benchmark: recon1d_nodes
+params: {lower: 0.0, upper: 1.0, ppc: 4, seed: 5, function: sin_pi}
+matrix:
+  - {method: [mls_linear], spacing: [random], cells: [5]}
+  - {method: [shepard, mls_linear], spacing: [equal, random], cells: [10, 20, 40]}
+expect:
+  - {method: shepard, spacing: equal, field: u, norm: l2, rate_min: 1.4}
+figures:
+  - {kind: reconstruction, method: mls_linear}
+  - {kind: convergence, by: spacing}
+tables:
+  - {kind: nodal_errors, columns: spacing}
+";
+
+const BASIS: &str = "\
+name: basis
+benchmark: recon1d_basis
+params: {method: imls_quadratic, function: x_plus_1, cells: 2}
+matrix:
+  points: [[-0.5, 0.0, 0.5], [-0.6, 0.4]]
+figures:
+  - {kind: basis}
+tables:
+  - {kind: basis_norms}
+";
+
+fn edited_in(valid: &str, from: &str, to: &str) -> String {
+    let text = valid.replacen(from, to, 1);
+    assert_ne!(text, valid, "'{from}' is not in the file");
+    text
+}
+
+#[test]
+fn matrix_blocks_expand_in_order_without_repeats() {
+    let exp = parse(RECONSTRUCTION).unwrap();
+    assert_eq!(exp.axes, ["method", "spacing", "cells"]);
+    assert_eq!(exp.runs.len(), 1 + 2 * 2 * 3);
+    assert!(exp.runs[0]
+        .run_id
+        .starts_with("mls_linear-spacingrandom-cells5-"));
+    assert!(exp.runs[1]
+        .run_id
+        .starts_with("shepard-spacingequal-cells10-"));
+    assert_eq!(exp.runs[0].params["weight"], ParamValue::Str("hat".into()));
+    assert_eq!(exp.figures[0].kind, FigureKind::Reconstruction);
+    let basis = parse(BASIS).unwrap();
+    assert_eq!(
+        basis.runs[1].params["points"],
+        ParamValue::List(vec![-0.6, 0.4])
+    );
+    assert!(basis.runs[1]
+        .run_id
+        .starts_with("imls_quadratic-points-0.6_0.4-"));
+}
+
+#[test]
+fn a_block_that_makes_a_run_twice_is_refused() {
+    let e = error(&edited_in(RECONSTRUCTION, "cells: [5]", "cells: [10]"));
+    check(
+        &e,
+        6,
+        5,
+        "matrix",
+        "block 2 makes the run mls_linear-spacingrandom-cells10-",
+        &[],
+    );
+    assert!(e.message.ends_with("again (block 1 made it first)"), "{e}");
+}
+
+#[test]
+fn blocks_need_the_same_axes() {
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "spacing: [random], cells: [5]}",
+        "cells: [5]}",
+    ));
+    check(
+        &e,
+        6,
+        5,
+        "matrix[1]",
+        "this one has [cells, method, spacing], the first has [cells, method]",
+        &[],
+    );
+    let e = error(&edited_in(RECONSTRUCTION, "matrix:\n  - {method: [mls_linear], spacing: [random], cells: [5]}\n  - {method: [shepard, mls_linear], spacing: [equal, random], cells: [10, 20, 40]}", "matrix: []"));
+    check(&e, 4, 9, "matrix", "non-empty list of such maps", &[]);
+}
+
+#[test]
+fn reconstruction_choices_list_the_valid_values() {
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "function: sin_pi",
+        "function: cos_pi",
+    ));
+    check(
+        &e,
+        3,
+        61,
+        "params.function",
+        "unknown value 'cos_pi'",
+        &["one", "x2", "sin_pi", "const_1_5"],
+    );
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "spacing: [random]",
+        "spacing: [jitter]",
+    ));
+    check(
+        &e,
+        5,
+        38,
+        "matrix[0].spacing[0]",
+        "unknown value 'jitter'",
+        &["equal", "random"],
+    );
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "method: [mls_linear]",
+        "method: [mpm]",
+    ));
+    check(
+        &e,
+        5,
+        15,
+        "matrix[0].method[0]",
+        "unknown method 'mpm'",
+        &["shepard", "imls_quadratic"],
+    );
+    let e = error(&edited_in(RECONSTRUCTION, "seed: 5", "seed: 0"));
+    check(&e, 3, 48, "params.seed", "expected an integer >= 1", &[]);
+}
+
+#[test]
+fn benchmark_checks_point_at_the_offending_value() {
+    let e = error(&edited_in(BASIS, "[-0.6, 0.4]", "[-0.6, 1.4]"));
+    check(
+        &e,
+        5,
+        30,
+        "matrix.points[1]",
+        "the point 1.4 lies outside [lower, upper] = [-1, 1]",
+        &[],
+    );
+    let e = error(&edited_in(BASIS, "cells: 2}", "cells: 2, scale: 11.0}"));
+    check(
+        &e,
+        3,
+        71,
+        "params.scale",
+        "reaches 16.5 cells; at most 15 are supported",
+        &[],
+    );
+    let e = error(&edited_in(BASIS, "[-0.6, 0.4]]", "-0.6]"));
+    check(
+        &e,
+        5,
+        30,
+        "matrix.points[1]",
+        "expected a non-empty list of finite numbers, found the number -0.6",
+        &[],
+    );
+    let e = error(&edited_in(BASIS, "[-0.6, 0.4]", "[-0.6, .nan]"));
+    check(
+        &e,
+        5,
+        37,
+        "matrix.points[1][1]",
+        "expected a finite number",
+        &[],
+    );
+}
+
+#[test]
+fn figures_and_tables_must_suit_the_benchmark() {
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "{kind: reconstruction, method: mls_linear}",
+        "{kind: basis}",
+    ));
+    check(
+        &e,
+        10,
+        12,
+        "figures[0].kind",
+        "a basis figure needs data that nodal reconstruction benchmarks do not record",
+        &["convergence", "reconstruction"],
+    );
+    assert!(!e.valid.contains(&"basis".to_string()));
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "kind: reconstruction, method: mls_linear",
+        "kind: reconstruction, by: spacing",
+    ));
+    check(
+        &e,
+        10,
+        28,
+        "figures[0].by",
+        "applies to convergence figures only",
+        &[],
+    );
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "{kind: nodal_errors, columns: spacing}",
+        "{kind: nodal_errors}",
+    ));
+    check(
+        &e,
+        13,
+        5,
+        "tables[0].columns",
+        "needs 'columns'",
+        &["method", "spacing"],
+    );
+    let e = error(&edited_in(
+        RECONSTRUCTION,
+        "{kind: nodal_errors, columns: spacing}",
+        "{kind: basis_norms}",
+    ));
+    check(
+        &e,
+        13,
+        12,
+        "tables[0].kind",
+        "a basis_norms table needs data",
+        &[],
+    );
+    let e = error(&edited(
+        "figures:\n  - {kind: convergence",
+        "tables: [{kind: nodal_errors, columns: G}]\nfigures:\n  - {kind: convergence",
+    ));
+    check(
+        &e,
+        11,
+        17,
+        "tables[0].kind",
+        "a nodal_errors table needs data that simulation benchmarks do not record",
+        &[],
+    );
+    let e = error(&edited_in(RECONSTRUCTION, "field: u", "field: velocity"));
+    check(
+        &e,
+        8,
+        46,
+        "expect[0].field",
+        "unknown field 'velocity'",
+        &["u"],
+    );
+    let e = error(&edited_in(RECONSTRUCTION, "norm: l2", "norm: rms"));
+    check(
+        &e,
+        8,
+        55,
+        "expect[0].norm",
+        "unknown norm 'rms'",
+        &["l2", "max"],
+    );
 }

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::fs;
 use std::path::Path;
 
+use mpmlab::benchmarks::BenchmarkKind;
 use mpmlab::experiment::{Expectation, Experiment, FigureKind, FigureSpec, OutputSpec};
 use mpmlab::output::{RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
@@ -57,6 +58,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         wall_seconds: 0.01 * cells as f64,
         axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
         final_norms,
+        reconstruction: None,
     }
 }
 
@@ -95,13 +97,16 @@ fn runs() -> Vec<RunSummary> {
 fn experiment(expect: Vec<Expectation>, figures: Vec<FigureSpec>) -> Experiment {
     Experiment {
         name: "gong_conv".into(),
+        description: String::new(),
         source_path: "experiments/gong_conv.yaml".into(),
         source_text: String::new(),
         benchmark: "mms_gong".into(),
+        kind: BenchmarkKind::Simulation,
         axes: ["G", "method", "cells"].map(String::from).to_vec(),
         output: OutputSpec { every: 10 },
         expect,
         figures,
+        tables: Vec::new(),
         runs: Vec::new(),
     }
 }
@@ -321,6 +326,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         fields: vec!["velocity".into(), "stress".into()],
         norm: "rms".into(),
         by: Some("G".into()),
+        select: Params::new(),
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let dir = tempfile::tempdir().unwrap();

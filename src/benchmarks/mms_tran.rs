@@ -148,6 +148,7 @@ mod tests {
             .filter_map(|spec| match spec.default {
                 ParamDefault::Float(x) => Some((spec.key.to_string(), ParamValue::Float(x))),
                 ParamDefault::Int(i) => Some((spec.key.to_string(), ParamValue::Int(i))),
+                ParamDefault::Text(t) => Some((spec.key.to_string(), ParamValue::Str(t.into()))),
                 ParamDefault::Required => None,
             })
             .collect();

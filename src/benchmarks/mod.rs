@@ -1,8 +1,10 @@
 //! Benchmark problems: domain, material, initial and boundary conditions, body force and the
-//! exact solution. A benchmark knows nothing of how a method maps data.
+//! exact solution. A benchmark knows nothing of how a method maps data. The reconstruction
+//! benchmarks (`scattered`) have no time stepping: a known function sampled at points.
 
 mod mms_gong;
 mod mms_tran;
+pub mod scattered;
 mod sine_mms;
 
 use nalgebra::{SMatrix, SVector};
@@ -22,6 +24,10 @@ pub enum ParamKind {
     PositiveReal,
     /// An integer >= 1.
     PositiveInt,
+    /// One of the listed names.
+    Choice(&'static [&'static str]),
+    /// A non-empty list of finite real numbers.
+    RealList,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +35,7 @@ pub enum ParamDefault {
     Required,
     Int(i64),
     Float(f64),
+    Text(&'static str),
 }
 
 pub struct ParamSpec {
@@ -51,7 +58,46 @@ pub struct BenchmarkInfo {
     pub check: fn(&Params) -> Result<(), ParamError>,
 }
 
-const CATALOG: &[BenchmarkInfo] = &[mms_gong::INFO_1D, mms_gong::INFO_2D, mms_tran::INFO];
+const CATALOG: &[BenchmarkInfo] = &[
+    mms_gong::INFO_1D,
+    mms_gong::INFO_2D,
+    mms_tran::INFO,
+    scattered::INFO_NODES,
+    scattered::INFO_BASIS,
+];
+
+/// What a run of a benchmark computes, and so which methods, measures and figures apply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchmarkKind {
+    /// A `Problem` stepped in time by an MPM method; errors at the particles.
+    Simulation,
+    /// Sampled data reconstructed at grid nodes by a reconstruction method; no time stepping.
+    Reconstruction,
+    /// A reconstruction that also records the weighted orthogonal basis of its points.
+    OrthogonalBasis,
+}
+
+impl BenchmarkKind {
+    pub fn is_reconstruction(self) -> bool {
+        self != BenchmarkKind::Simulation
+    }
+}
+
+impl std::fmt::Display for BenchmarkKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BenchmarkKind::Simulation => "simulation",
+            BenchmarkKind::Reconstruction => "nodal reconstruction",
+            BenchmarkKind::OrthogonalBasis => "orthogonal-basis reconstruction",
+        })
+    }
+}
+
+/// The kind of a catalogue entry: the reconstruction benchmarks say which they are, every
+/// other benchmark is a simulation.
+pub fn kind(info: &BenchmarkInfo) -> BenchmarkKind {
+    scattered::kind(info.name).unwrap_or(BenchmarkKind::Simulation)
+}
 
 pub fn catalog() -> &'static [BenchmarkInfo] {
     CATALOG

@@ -8,14 +8,16 @@ use super::values::{pick, positive_int};
 use super::yaml::{find, reject_unknown_keys, require, Entry, Node, NodeKind};
 use super::OutputSpec;
 
-const TOP_LEVEL_KEYS: [&str; 7] = [
+const TOP_LEVEL_KEYS: [&str; 9] = [
     "name",
+    "description",
     "benchmark",
     "params",
     "matrix",
     "output",
     "expect",
     "figures",
+    "tables",
 ];
 
 /// The top-level entries, all of known keys.
@@ -72,6 +74,14 @@ pub(crate) fn name(sections: &Sections) -> Result<String, ConfigError> {
         ));
     }
     Ok(name.to_string())
+}
+
+/// The optional `description`: text the report prints under its title.
+pub(crate) fn description(sections: &Sections) -> Result<String, ConfigError> {
+    match sections.get("description") {
+        Some(entry) => Ok(entry.value.as_text("description")?.trim().to_string()),
+        None => Ok(String::new()),
+    }
 }
 
 /// The chosen benchmark and where it is named (the origin of every default value).

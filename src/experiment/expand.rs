@@ -1,5 +1,8 @@
-//! Matrix expansion: the cartesian product of the axes (last axis fastest), each run resolved
-//! against the benchmark's defaults, checked by the benchmark and given its id.
+//! Matrix expansion: the cartesian product of each block's axes (last axis fastest), blocks in
+//! file order, each run resolved against the benchmark's defaults, checked by the benchmark
+//! and given its id.
+
+use std::collections::HashMap;
 
 use crate::benchmarks::ParamDefault;
 use crate::params::{ParamError, ParamValue, Params};
@@ -7,7 +10,7 @@ use crate::params::{ParamError, ParamValue, Params};
 use super::document::Benchmark;
 use super::error::ConfigError;
 use super::run_id::{config_body, config_yaml, run_id};
-use super::space::{ParamSpace, Written};
+use super::space::{Block, ParamSpace, Written};
 use super::values::METHOD_KEY;
 use super::yaml::child_field;
 use super::RunSpec;
@@ -21,14 +24,31 @@ pub(crate) fn expand(
     space: &ParamSpace,
     output_every: usize,
 ) -> Result<Vec<RunSpec>, ConfigError> {
-    let count = run_count(space)?;
+    run_count(space)?;
     let defaults = defaults(benchmark);
-    (0..count)
-        .map(|index| {
-            let chosen = choose(space, index);
-            resolve(experiment, benchmark, &defaults, &chosen, output_every)
-        })
-        .collect()
+    let mut runs: Vec<RunSpec> = Vec::new();
+    // Run id -> its block, to refuse a run that two blocks both make.
+    let mut made_by: HashMap<String, usize> = HashMap::new();
+    for (b, block) in space.blocks.iter().enumerate() {
+        for index in 0..block_size(block) {
+            let chosen = choose(space, block, index);
+            let run = resolve(experiment, benchmark, &defaults, &chosen, output_every)?;
+            if let Some(earlier) = made_by.insert(run.run_id.clone(), b) {
+                return Err(ConfigError::at(
+                    block.pos,
+                    "matrix",
+                    format!(
+                        "block {} makes the run {} again (block {} made it first)",
+                        b + 1,
+                        run.run_id,
+                        earlier + 1
+                    ),
+                ));
+            }
+            runs.push(run);
+        }
+    }
+    Ok(runs)
 }
 
 /// The benchmark's parameters that have a default, at their defaults.
@@ -39,30 +59,47 @@ fn defaults(benchmark: &Benchmark) -> Params {
             ParamDefault::Required => continue,
             ParamDefault::Int(i) => ParamValue::Int(i),
             ParamDefault::Float(x) => ParamValue::Float(x),
+            ParamDefault::Text(s) => ParamValue::Str(s.to_string()),
         };
         defaults.insert(p.key.to_string(), value);
     }
     defaults
 }
 
-fn run_count(space: &ParamSpace) -> Result<usize, ConfigError> {
-    space
+/// Runs of one block, saturating: `run_count` rejects the sums that overflow.
+fn block_size(block: &Block) -> usize {
+    block
         .axes
         .iter()
         .try_fold(1usize, |n, axis| n.checked_mul(axis.values.len()))
+        .unwrap_or(usize::MAX)
+}
+
+fn run_count(space: &ParamSpace) -> Result<usize, ConfigError> {
+    space
+        .blocks
+        .iter()
+        .try_fold(0usize, |n, block| n.checked_add(block_size(block)))
         .filter(|&n| n <= MAX_RUNS)
         .ok_or_else(|| {
             let sizes: Vec<String> = space
-                .axes
+                .blocks
                 .iter()
-                .map(|a| a.values.len().to_string())
+                .map(|block| {
+                    let axes: Vec<String> = block
+                        .axes
+                        .iter()
+                        .map(|a| a.values.len().to_string())
+                        .collect();
+                    axes.join(" x ")
+                })
                 .collect();
             ConfigError::at(
                 space.matrix_pos,
                 "matrix",
                 format!(
                     "the matrix ({} values per axis) expands to more than {MAX_RUNS} runs",
-                    sizes.join(" x ")
+                    sizes.join(" + ")
                 ),
             )
         })
@@ -76,11 +113,11 @@ struct Chosen<'a> {
     is_axis: bool,
 }
 
-/// The values of run number `index`: the fixed ones, then one per axis in file order.
-fn choose(space: &ParamSpace, index: usize) -> Vec<Chosen<'_>> {
-    let mut from_axes = Vec::with_capacity(space.axes.len());
+/// The values of run number `index` of `block`: the fixed ones, then one per axis in order.
+fn choose<'a>(space: &'a ParamSpace, block: &'a Block, index: usize) -> Vec<Chosen<'a>> {
+    let mut from_axes = Vec::with_capacity(block.axes.len());
     let mut rest = index;
-    for axis in space.axes.iter().rev() {
+    for axis in block.axes.iter().rev() {
         from_axes.push(Chosen {
             key: &axis.key,
             written: &axis.values[rest % axis.values.len()],
@@ -182,7 +219,7 @@ mod tests {
     use super::*;
     use crate::benchmarks::{BenchmarkInfo, ParamKind, ParamSpec};
     use crate::experiment::error::Pos;
-    use crate::experiment::space::Axis;
+    use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
 
     /// A benchmark whose check rejects its own default, which no real benchmark does.
@@ -232,14 +269,17 @@ mod tests {
                 METHOD_KEY.to_string(),
                 written(ParamValue::Str("mpm".into()), 3, "params.method"),
             )],
-            axes: vec![Axis {
-                key: "x".into(),
-                kind: ValueKind::Param(ParamKind::Real),
-                values: xs
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, v)| written(v, 5, &format!("matrix.x[{i}]")))
-                    .collect(),
+            blocks: vec![Block {
+                axes: vec![Axis {
+                    key: "x".into(),
+                    kind: ValueKind::Param(ParamKind::Real),
+                    values: xs
+                        .into_iter()
+                        .enumerate()
+                        .map(|(i, v)| written(v, 5, &format!("matrix.x[{i}]")))
+                        .collect(),
+                }],
+                pos: Pos { line: 5, column: 3 },
             }],
             matrix_pos: Pos { line: 4, column: 1 },
         }

@@ -1,12 +1,12 @@
 //! `expect` entries: bounds on convergence rates and final errors, for `report --check`.
 
-use crate::output::ERROR_FIELDS;
-use crate::params::Params;
+use crate::output::Measures;
 
 use super::error::ConfigError;
 use super::measures::{error_field, norm};
+use super::select::selection;
 use super::space::ParamSpace;
-use super::values::{finite, normalize, positive};
+use super::values::{finite, positive};
 use super::yaml::{child_field, find, read_list, require, Entry, Node};
 use super::Expectation;
 
@@ -16,16 +16,24 @@ const BOUNDS: [&str; 3] = ["rate_min", "rate_max", "error_max"];
 pub(crate) fn read(
     section: Option<&Entry>,
     space: &ParamSpace,
+    measures: Measures,
 ) -> Result<Vec<Expectation>, ConfigError> {
-    read_list(section, |node, field| read_entry(node, field, space))
+    read_list(section, |node, field| {
+        read_entry(node, field, space, measures)
+    })
 }
 
-fn read_entry(node: &Node, parent: &str, space: &ParamSpace) -> Result<Expectation, ConfigError> {
+fn read_entry(
+    node: &Node,
+    parent: &str,
+    space: &ParamSpace,
+    measures: Measures,
+) -> Result<Expectation, ConfigError> {
     let entries = node.entries(parent)?;
-    let select = selection(&entries, parent, space)?;
+    let select = selection(&entries, parent, space, &KEYS)?;
     let field_entry =
-        require(&entries, "field", node.pos, parent).map_err(|e| e.with_valid(ERROR_FIELDS))?;
-    let field = error_field(field_entry.value, &child_field(parent, "field"))?;
+        require(&entries, "field", node.pos, parent).map_err(|e| e.with_valid(measures.fields))?;
+    let field = error_field(field_entry.value, &child_field(parent, "field"), measures)?;
     let bound = |key: &str, read: fn(&Node, &str) -> Result<f64, ConfigError>| {
         find(&entries, key)
             .map(|e| read(e.value, &child_field(parent, key)))
@@ -53,32 +61,10 @@ fn read_entry(node: &Node, parent: &str, space: &ParamSpace) -> Result<Expectati
     Ok(Expectation {
         select,
         field,
-        norm: norm(&entries, parent)?,
+        norm: norm(&entries, parent, measures)?,
         rate_min,
         rate_max,
         error_max,
         line: node.pos.line,
     })
-}
-
-/// The entries that are not fixed keys select runs by the value of a matrix axis.
-fn selection(entries: &[Entry], parent: &str, space: &ParamSpace) -> Result<Params, ConfigError> {
-    let mut select = Params::new();
-    for e in entries.iter().filter(|e| !KEYS.contains(&e.key)) {
-        let field = child_field(parent, e.key);
-        let unknown = format!("unknown key '{}'", e.key);
-        let axis = space.group_axis(e.key, e.key_pos, &field, unknown, &KEYS)?;
-        let value = normalize(axis.kind, e.value, &field)?;
-        if !axis.values.iter().any(|w| w.value == value) {
-            let values = axis.values.iter().map(|w| &w.value);
-            return Err(ConfigError::at(
-                e.value.pos,
-                field,
-                format!("no run has {} = {value}", e.key),
-            )
-            .with_valid(values));
-        }
-        select.insert(e.key.to_string(), value);
-    }
-    Ok(select)
 }

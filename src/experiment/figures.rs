@@ -1,55 +1,88 @@
 //! `figures` entries: which plots the report draws.
 
-use crate::output::ERROR_FIELDS;
+use crate::benchmarks::BenchmarkKind;
+use crate::output::Measures;
 
 use super::error::ConfigError;
+use super::kinds::{Item, Kinds};
 use super::measures::{error_field, norm};
+use super::select::axis_key;
 use super::space::ParamSpace;
-use super::values::pick;
-use super::yaml::{
-    child_field, find, item_field, read_list, reject_unknown_keys, require, Entry, Node,
-};
+use super::yaml::{child_field, find, item_field, Entry, Node};
 use super::{FigureKind, FigureSpec};
 
-const KEYS: [&str; 4] = ["kind", "fields", "norm", "by"];
-const KINDS: [(&str, FigureKind); 1] = [("convergence", FigureKind::Convergence)];
+/// The keys only a convergence figure takes.
+const CONVERGENCE_KEYS: [&str; 3] = ["fields", "norm", "by"];
+const KINDS: Kinds<FigureKind> = Kinds {
+    what: "figure",
+    kinds: &[
+        ("convergence", FigureKind::Convergence),
+        ("reconstruction", FigureKind::Reconstruction),
+        ("basis", FigureKind::Basis),
+    ],
+    keys: &["kind", "fields", "norm", "by"],
+    suits: draws_for,
+};
 
 pub(crate) fn read(
     section: Option<&Entry>,
     space: &ParamSpace,
+    benchmark: BenchmarkKind,
 ) -> Result<Vec<FigureSpec>, ConfigError> {
-    read_list(section, |node, field| read_entry(node, field, space))
+    KINDS.read_list(section, space, benchmark, |item| {
+        figure(item, space, benchmark)
+    })
 }
 
-fn read_entry(node: &Node, parent: &str, space: &ParamSpace) -> Result<FigureSpec, ConfigError> {
-    let entries = node.entries(parent)?;
-    reject_unknown_keys(&entries, &KEYS, parent)?;
-    let kind_entry = require(&entries, "kind", node.pos, parent)
-        .map_err(|e| e.with_valid(KINDS.iter().map(|(name, _)| name)))?;
-    let (_, kind) = pick(
-        kind_entry.value,
-        &child_field(parent, "kind"),
-        "figure kind",
-        &KINDS,
-        |(name, _)| name,
-    )?;
+fn figure(
+    item: Item<FigureKind>,
+    space: &ParamSpace,
+    benchmark: BenchmarkKind,
+) -> Result<FigureSpec, ConfigError> {
+    let Item {
+        parent,
+        entries,
+        kind,
+        select,
+        ..
+    } = item;
+    if *kind != FigureKind::Convergence {
+        if let Some(e) = entries.iter().find(|e| CONVERGENCE_KEYS.contains(&e.key)) {
+            return Err(ConfigError::at(
+                e.key_pos,
+                child_field(parent, e.key),
+                format!("'{}' applies to convergence figures only", e.key),
+            ));
+        }
+    }
+    let measures = Measures::of(benchmark);
     let fields = match find(&entries, "fields") {
-        Some(e) => fields(e.value, &child_field(parent, "fields"))?,
-        None => ERROR_FIELDS.iter().map(|f| f.to_string()).collect(),
+        Some(e) => fields(e.value, &child_field(parent, "fields"), measures)?,
+        None => measures.fields.iter().map(|f| f.to_string()).collect(),
     };
     let by = match find(&entries, "by") {
-        Some(e) => Some(by(e.value, &child_field(parent, "by"), space)?),
+        Some(e) => Some(axis_key(e.value, &child_field(parent, "by"), space)?),
         None => None,
     };
     Ok(FigureSpec {
         kind: kind.clone(),
         fields,
-        norm: norm(&entries, parent)?,
+        norm: norm(&entries, parent, measures)?,
         by,
+        select,
     })
 }
 
-fn fields(node: &Node, field: &str) -> Result<Vec<String>, ConfigError> {
+/// Whether runs of `benchmark` hold what a figure of `kind` shows.
+fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
+    match kind {
+        FigureKind::Convergence => true,
+        FigureKind::Reconstruction => benchmark.is_reconstruction(),
+        FigureKind::Basis => benchmark == BenchmarkKind::OrthogonalBasis,
+    }
+}
+
+fn fields(node: &Node, field: &str, measures: Measures) -> Result<Vec<String>, ConfigError> {
     let items = node.as_list(field)?;
     if items.is_empty() {
         return Err(ConfigError::at(
@@ -57,12 +90,12 @@ fn fields(node: &Node, field: &str) -> Result<Vec<String>, ConfigError> {
             field,
             "list at least one field, or omit 'fields' for all",
         )
-        .with_valid(ERROR_FIELDS));
+        .with_valid(measures.fields));
     }
     let mut fields: Vec<String> = Vec::with_capacity(items.len());
     for (i, item) in items.iter().enumerate() {
         let item_field = item_field(field, i);
-        let name = error_field(item, &item_field)?;
+        let name = error_field(item, &item_field, measures)?;
         if fields.contains(&name) {
             return Err(ConfigError::at(
                 item.pos,
@@ -73,14 +106,4 @@ fn fields(node: &Node, field: &str) -> Result<Vec<String>, ConfigError> {
         fields.push(name);
     }
     Ok(fields)
-}
-
-/// The axis whose values become the curves of one figure.
-fn by(node: &Node, field: &str, space: &ParamSpace) -> Result<String, ConfigError> {
-    let key = node
-        .as_text(field)
-        .map_err(|e| e.with_valid(space.group_axis_names()))?;
-    let unknown = format!("'{key}' is not a matrix axis");
-    let axis = space.group_axis(key, node.pos, field, unknown, &[])?;
-    Ok(axis.key.clone())
 }

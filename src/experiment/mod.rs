@@ -6,15 +6,20 @@ mod error;
 mod expand;
 mod expect;
 mod figures;
+mod kinds;
 mod measures;
 mod run_id;
 mod run_spec;
+mod select;
 mod space;
+mod tables;
 mod values;
 mod yaml;
 
 use std::path::{Path, PathBuf};
 
+use crate::benchmarks::{self, BenchmarkKind};
+use crate::output::Measures;
 use crate::params::Params;
 
 pub use error::ConfigError;
@@ -42,21 +47,27 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let root = yaml::parse_tree(text)?;
     let sections = Sections::read(&root)?;
     let name = document::name(&sections)?;
+    let description = document::description(&sections)?;
     let benchmark = document::benchmark(&sections)?;
+    let kind = benchmarks::kind(benchmark.info);
     let space = ParamSpace::read(&sections, benchmark.info)?;
     let output = document::output(&sections)?;
-    let expect = expect::read(sections.get("expect"), &space)?;
-    let figures = figures::read(sections.get("figures"), &space)?;
+    let expect = expect::read(sections.get("expect"), &space, Measures::of(kind))?;
+    let figures = figures::read(sections.get("figures"), &space, kind)?;
+    let tables = tables::read(sections.get("tables"), &space, kind)?;
     let runs = expand::expand(&name, &benchmark, &space, output.every)?;
     Ok(Experiment {
         name,
+        description,
         source_path: path.to_path_buf(),
         source_text: text.to_string(),
         benchmark: benchmark.info.name.to_string(),
-        axes: space.axes.iter().map(|a| a.key.clone()).collect(),
+        kind,
+        axes: space.axes().iter().map(|a| a.key.clone()).collect(),
         output,
         expect,
         figures,
+        tables,
         runs,
     })
 }
@@ -65,16 +76,20 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
 #[derive(Clone, Debug)]
 pub struct Experiment {
     pub name: String,
+    /// Free text for the report (what is reproduced, what the paper leaves open).
+    pub description: String,
     /// The file it was read from, and its text (copied next to the results so that a
     /// report can be made from a results directory alone).
     pub source_path: PathBuf,
     pub source_text: String,
     pub benchmark: String,
+    pub kind: BenchmarkKind,
     /// Matrix axis names in file order (`method` and `cells` included when they are axes).
     pub axes: Vec<String>,
     pub output: OutputSpec,
     pub expect: Vec<Expectation>,
     pub figures: Vec<FigureSpec>,
+    pub tables: Vec<TableSpec>,
     /// One entry per run, in expansion order (the cartesian product, last axis fastest).
     pub runs: Vec<RunSpec>,
 }
@@ -122,6 +137,10 @@ pub struct Expectation {
 pub enum FigureKind {
     /// log10(error) against log10(h) with fitted slopes.
     Convergence,
+    /// Per run: u(x), the reconstructed nodal values and the data points.
+    Reconstruction,
+    /// Per run: the weighted orthogonal polynomials with the data points on them.
+    Basis,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -131,4 +150,23 @@ pub struct FigureSpec {
     pub norm: String,
     /// Axis whose values become separate curves in one figure (others make separate figures).
     pub by: Option<String>,
+    /// Axis values a run must have to be drawn; empty = every run.
+    pub select: Params,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum TableKind {
+    /// u - u^h at every node, one column per value of `columns` (Gong Tables 4.1-4.2).
+    NodalErrors,
+    /// <p_i, p_i> and the kept polynomials, one row per run (Tran Figs 1-3).
+    BasisNorms,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableSpec {
+    pub kind: TableKind,
+    /// Axis whose values become the columns of one table (others make separate tables).
+    pub columns: Option<String>,
+    /// Axis values a run must have to be listed; empty = every run.
+    pub select: Params,
 }

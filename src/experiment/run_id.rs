@@ -29,11 +29,20 @@ pub(crate) fn config_yaml(experiment: &str, body: &str) -> String {
     format!("experiment: {experiment}\n{body}")
 }
 
-/// `<method>-<axis><value>-...-<hash12>` over the non-method axes in file order.
+/// `<method>-<axis><value>-...-<hash12>` over the non-method axes in file order; a list
+/// value is written with `_` between its numbers.
 pub(crate) fn run_id(method: &str, axes: &[(&str, &ParamValue)], body: &str) -> String {
     let mut id = method.to_string();
     for (key, value) in axes {
-        let _ = write!(id, "-{key}{value}");
+        match value {
+            ParamValue::List(values) => {
+                let items: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
+                let _ = write!(id, "-{key}{}", items.join("_"));
+            }
+            _ => {
+                let _ = write!(id, "-{key}{value}");
+            }
+        }
     }
     // The top 48 bits of the hash: 12 hex digits.
     let _ = write!(id, "-{:012x}", fnv1a64(body.as_bytes()) >> 16);
@@ -82,8 +91,9 @@ mod tests {
     fn ids_list_axes_in_order_and_replace_odd_characters() {
         let g = ParamValue::Float(0.1);
         let tag = ParamValue::Str("a b/c".into());
-        let id = run_id("mpm", &[("G", &g), ("tag", &tag)], "body");
+        let points = ParamValue::List(vec![-0.5, 1.0]);
+        let id = run_id("mpm", &[("G", &g), ("tag", &tag), ("x", &points)], "body");
         let hash = format!("{:012x}", fnv1a64(b"body") >> 16);
-        assert_eq!(id, format!("mpm-G0.1-taga_b_c-{hash}"));
+        assert_eq!(id, format!("mpm-G0.1-taga_b_c-x-0.5_1.0-{hash}"));
     }
 }

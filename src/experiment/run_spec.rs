@@ -41,6 +41,7 @@ fn params_json(params: &Params) -> Value {
                 ParamValue::Int(i) => Value::from(*i),
                 ParamValue::Float(x) => Value::from(*x),
                 ParamValue::Str(s) => Value::from(s.as_str()),
+                ParamValue::List(values) => Value::from(values.clone()),
             };
             (key.clone(), value)
         })

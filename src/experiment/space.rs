@@ -1,16 +1,20 @@
 //! The parameter space of an experiment: the values fixed in `params` and the axes of
 //! `matrix`, each key given once, the method and every required parameter given somewhere.
+//!
+//! `matrix` is a map of axes (one cartesian product) or a list of such maps, the blocks: the
+//! runs are the union of the blocks' products. Blocks let one experiment hold studies of
+//! different shapes (a few profiles at one resolution beside a refinement study) without
+//! running their whole product.
 
 use std::collections::HashMap;
 
-use crate::benchmarks::{BenchmarkInfo, ParamDefault};
-use crate::methods;
+use crate::benchmarks::{self, BenchmarkInfo, ParamDefault};
 use crate::params::ParamValue;
 
 use super::document::Sections;
 use super::error::{ConfigError, Pos};
-use super::values::{normalize, settable_kind, ValueKind, METHOD_KEY};
-use super::yaml::{child_field, item_field, Entry, Node};
+use super::values::{method_names, normalize, settable_kind, ValueKind, METHOD_KEY};
+use super::yaml::{child_field, item_field, Entry, Node, NodeKind};
 
 /// The axis along which rates are fitted; it never selects or groups runs.
 const CELLS_KEY: &str = "cells";
@@ -30,10 +34,18 @@ pub(crate) struct Axis {
     pub values: Vec<Written>,
 }
 
+/// One cartesian product of axes.
+pub(crate) struct Block {
+    /// In the order of the first block's axes (file order there).
+    pub axes: Vec<Axis>,
+    /// Where the block is written, for errors about the runs it makes.
+    pub pos: Pos,
+}
+
 pub(crate) struct ParamSpace {
     pub fixed: Vec<(String, Written)>,
-    /// In file order.
-    pub axes: Vec<Axis>,
+    /// At least one; all with the same axes. Without a matrix, one block without axes.
+    pub blocks: Vec<Block>,
     /// Where the matrix is (the document start without one), for errors about its size.
     pub matrix_pos: Pos,
 }
@@ -44,21 +56,42 @@ impl ParamSpace {
             Some(params) => read_params(params, info)?,
             None => Vec::new(),
         };
-        let axes = match sections.get("matrix") {
+        let matrix_pos = sections.key_pos("matrix");
+        let blocks = match sections.get("matrix") {
             Some(matrix) => read_matrix(matrix, info, &fixed)?,
-            None => Vec::new(),
+            None => vec![Block {
+                axes: Vec::new(),
+                pos: matrix_pos,
+            }],
         };
         let space = ParamSpace {
             fixed,
-            axes,
-            matrix_pos: sections.key_pos("matrix"),
+            blocks,
+            matrix_pos,
         };
         space.require_given(info, sections.key_pos("params"))?;
         Ok(space)
     }
 
+    /// The axes (keys and kinds; their values are the first block's).
+    pub fn axes(&self) -> &[Axis] {
+        &self.blocks[0].axes
+    }
+
+    /// Every value axis `key` takes in any block, in order of first appearance.
+    pub fn axis_values(&self, key: &str) -> Vec<&ParamValue> {
+        let mut values: Vec<&ParamValue> = Vec::new();
+        let axes = self.blocks.iter().flat_map(|b| &b.axes);
+        for written in axes.filter(|a| a.key == key).flat_map(|a| &a.values) {
+            if !values.contains(&&written.value) {
+                values.push(&written.value);
+            }
+        }
+        values
+    }
+
     fn is_given(&self, key: &str) -> bool {
-        self.fixed.iter().any(|(k, _)| k == key) || self.axes.iter().any(|a| a.key == key)
+        self.fixed.iter().any(|(k, _)| k == key) || self.axes().iter().any(|a| a.key == key)
     }
 
     /// The method and every parameter without a default must be in `params` or `matrix`.
@@ -74,7 +107,8 @@ impl ParamSpace {
             )
         };
         if !self.is_given(METHOD_KEY) {
-            return Err(missing(METHOD_KEY).with_valid(methods::preset_names()));
+            let valid = method_names(benchmarks::kind(info));
+            return Err(missing(METHOD_KEY).with_valid(valid));
         }
         match info
             .params
@@ -88,7 +122,7 @@ impl ParamSpace {
 
     /// The axes that split runs into convergence groups: all but `cells`.
     pub fn group_axes(&self) -> impl Iterator<Item = &Axis> {
-        self.axes.iter().filter(|a| a.key != CELLS_KEY)
+        self.axes().iter().filter(|a| a.key != CELLS_KEY)
     }
 
     /// The group axis named `key`. Otherwise an error at `pos` saying `unknown` (or why
@@ -134,17 +168,71 @@ fn read_params(
         .collect()
 }
 
+/// A map of axes, or a non-empty list of them with the same keys.
 fn read_matrix(
     section: &Entry,
     info: &BenchmarkInfo,
     fixed: &[(String, Written)],
-) -> Result<Vec<Axis>, ConfigError> {
-    let entries = section.value.entries("matrix")?;
-    entries
+) -> Result<Vec<Block>, ConfigError> {
+    let node = section.value;
+    let NodeKind::List(items) = &node.kind else {
+        return Ok(vec![read_block(node, "matrix", info, fixed)?]);
+    };
+    if items.is_empty() {
+        return Err(node.expected(
+            "matrix",
+            "a map of axes or a non-empty list of such maps (blocks)",
+        ));
+    }
+    let mut blocks = Vec::with_capacity(items.len());
+    for (i, item) in items.iter().enumerate() {
+        let mut block = read_block(item, &item_field("matrix", i), info, fixed)?;
+        if let Some(first) = blocks.first() {
+            align(&mut block, first, &item_field("matrix", i))?;
+        }
+        blocks.push(block);
+    }
+    Ok(blocks)
+}
+
+/// Puts `block`'s axes in the order of `first`'s, which must have the same keys: every run
+/// then has a value for every axis.
+fn align(block: &mut Block, first: &Block, field: &str) -> Result<(), ConfigError> {
+    let keys = |b: &Block| {
+        let mut keys: Vec<String> = b.axes.iter().map(|a| a.key.clone()).collect();
+        keys.sort();
+        keys
+    };
+    if keys(block) != keys(first) {
+        return Err(ConfigError::at(
+            block.pos,
+            field,
+            format!(
+                "every block of the matrix lists the same axes; this one has [{}], the first \
+                 has [{}]",
+                keys(block).join(", "),
+                keys(first).join(", ")
+            ),
+        ));
+    }
+    block
+        .axes
+        .sort_by_key(|a| first.axes.iter().position(|f| f.key == a.key));
+    Ok(())
+}
+
+fn read_block(
+    node: &Node,
+    field: &str,
+    info: &BenchmarkInfo,
+    fixed: &[(String, Written)],
+) -> Result<Block, ConfigError> {
+    let entries = node.entries(field)?;
+    let axes = entries
         .iter()
         .map(|e| {
-            let kind = settable_kind(info, e, "matrix")?;
-            let field = child_field("matrix", e.key);
+            let kind = settable_kind(info, e, field)?;
+            let field = child_field(field, e.key);
             if let Some((_, fixed)) = fixed.iter().find(|(k, _)| k == e.key) {
                 return Err(ConfigError::at(
                     e.key_pos,
@@ -157,7 +245,11 @@ fn read_matrix(
             }
             read_axis(kind, e, &field)
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    Ok(Block {
+        axes,
+        pos: node.pos,
+    })
 }
 
 fn read_axis(kind: ValueKind, entry: &Entry, field: &str) -> Result<Axis, ConfigError> {

@@ -1,12 +1,12 @@
 //! Scalar values: the kind each settable key takes, and the normalisation of what the file
 //! wrote into the canonical `ParamValue` that run ids hash (`G: 1` and `G: 1.0` are one run).
 
-use crate::benchmarks::{BenchmarkInfo, ParamKind};
-use crate::methods;
+use crate::benchmarks::{self, BenchmarkInfo, BenchmarkKind, ParamKind};
 use crate::params::ParamValue;
+use crate::{methods, reconstruction_methods};
 
 use super::error::ConfigError;
-use super::yaml::{child_field, Entry, Node, NodeKind};
+use super::yaml::{child_field, item_field, Entry, Node, NodeKind};
 
 /// The key that selects the method; settable like a benchmark parameter.
 pub(crate) const METHOD_KEY: &str = "method";
@@ -14,7 +14,18 @@ pub(crate) const METHOD_KEY: &str = "method";
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum ValueKind {
     Param(ParamKind),
-    Method,
+    /// A method from the catalogue that serves this kind of benchmark.
+    Method(BenchmarkKind),
+}
+
+/// The methods a kind of benchmark accepts: MPM presets for simulations, reconstruction
+/// methods for the reconstruction benchmarks.
+pub(crate) fn method_names(kind: BenchmarkKind) -> Vec<&'static str> {
+    if kind.is_reconstruction() {
+        reconstruction_methods::method_names()
+    } else {
+        methods::preset_names()
+    }
 }
 
 /// The kind of a key of `params` or `matrix`: a parameter of the benchmark or the method.
@@ -25,7 +36,7 @@ pub(crate) fn settable_kind(
     parent: &str,
 ) -> Result<ValueKind, ConfigError> {
     if entry.key == METHOD_KEY {
-        return Ok(ValueKind::Method);
+        return Ok(ValueKind::Method(benchmarks::kind(info)));
     }
     match info.params.iter().find(|p| p.key == entry.key) {
         Some(p) => Ok(ValueKind::Param(p.kind)),
@@ -47,12 +58,29 @@ pub(crate) fn normalize(
     field: &str,
 ) -> Result<ParamValue, ConfigError> {
     match kind {
-        ValueKind::Method => {
-            choice(node, field, "method", &methods::preset_names()).map(ParamValue::Str)
+        ValueKind::Method(kind) => {
+            choice(node, field, "method", &method_names(kind)).map(ParamValue::Str)
         }
         ValueKind::Param(ParamKind::Real) => finite(node, field).map(ParamValue::Float),
         ValueKind::Param(ParamKind::PositiveReal) => positive(node, field).map(ParamValue::Float),
         ValueKind::Param(ParamKind::PositiveInt) => positive_int(node, field).map(ParamValue::Int),
+        ValueKind::Param(ParamKind::Choice(names)) => {
+            choice(node, field, "value", names).map(ParamValue::Str)
+        }
+        ValueKind::Param(ParamKind::RealList) => real_list(node, field).map(ParamValue::List),
+    }
+}
+
+/// A non-empty list of finite numbers; a bad element is reported at its own position.
+fn real_list(node: &Node, field: &str) -> Result<Vec<f64>, ConfigError> {
+    const EXPECTED: &str = "a non-empty list of finite numbers";
+    match &node.kind {
+        NodeKind::List(items) if !items.is_empty() => items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| finite(item, &item_field(field, i)))
+            .collect(),
+        _ => Err(node.expected(field, EXPECTED)),
     }
 }
 
@@ -175,12 +203,43 @@ mod tests {
 
     #[test]
     fn methods_are_checked_against_the_presets() {
-        let ok = normalize(ValueKind::Method, &node("mpm"), "params.method");
+        let simulation = ValueKind::Method(BenchmarkKind::Simulation);
+        let ok = normalize(simulation, &node("mpm"), "params.method");
         assert_eq!(ok, Ok(ParamValue::Str("mpm".into())));
-        let e = normalize(ValueKind::Method, &node("flip"), "params.method").unwrap_err();
+        let e = normalize(simulation, &node("flip"), "params.method").unwrap_err();
         assert!(e.message.contains("unknown method 'flip'"));
         assert!(e.valid.contains(&"mpm".to_string()));
-        let e = normalize(ValueKind::Method, &node("3"), "params.method").unwrap_err();
+        let e = normalize(simulation, &node("3"), "params.method").unwrap_err();
         assert!(e.valid.contains(&"mpm".to_string()), "{e}");
+    }
+
+    #[test]
+    fn reconstruction_benchmarks_take_reconstruction_methods() {
+        let kind = ValueKind::Method(BenchmarkKind::Reconstruction);
+        let ok = normalize(kind, &node("shepard"), "params.method");
+        assert_eq!(ok, Ok(ParamValue::Str("shepard".into())));
+        let e = normalize(kind, &node("mpm"), "params.method").unwrap_err();
+        assert!(e.valid.contains(&"imls_quadratic".to_string()), "{e}");
+    }
+
+    #[test]
+    fn choices_and_lists() {
+        let kind = ParamKind::Choice(&["equal", "random"]);
+        assert_eq!(norm(kind, "random"), Ok(ParamValue::Str("random".into())));
+        let e = norm(kind, "rand").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            ":1:4: field 'params.v': unknown value 'rand' (valid: equal, random)"
+        );
+        assert_eq!(
+            norm(ParamKind::RealList, "[-1, 0.5]"),
+            Ok(ParamValue::List(vec![-1.0, 0.5]))
+        );
+        let e = norm(ParamKind::RealList, "[0.1, x]").unwrap_err();
+        assert_eq!((e.field.as_str(), e.column), ("params.v[1]", 10));
+        for bad in ["[]", "0.5", "x"] {
+            let e = norm(ParamKind::RealList, bad).unwrap_err();
+            assert!(e.message.contains("non-empty list"), "{bad}: {e}");
+        }
     }
 }

@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use crate::benchmarks::BenchmarkKind;
 use crate::params::Params;
 
 /// Bumped whenever a name or shape below changes meaning.
@@ -12,6 +13,34 @@ pub const SCHEMA_VERSION: i64 = 2;
 pub const ERROR_FIELDS: [&str; 4] = ["displacement", "velocity", "stress", "density"];
 /// The error norms: `l2 = sqrt(sum_p V_p |e_p|^2)`, `rms = sqrt(sum_p |e_p|^2 / Np)`.
 pub const NORMS: [&str; 2] = ["l2", "rms"];
+
+/// A reconstruction run's error field, u - u^h at the evaluation points.
+pub const RECONSTRUCTION_FIELDS: [&str; 1] = ["u"];
+/// Its norms: `l2 = sqrt(sum_e h e_e^2)` (Gong sec 5.2), `max = max_e |e_e|`.
+pub const RECONSTRUCTION_NORMS: [&str; 2] = ["l2", "max"];
+
+/// The error fields a kind of run reports, each in each of the norms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Measures {
+    pub fields: &'static [&'static str],
+    pub norms: &'static [&'static str],
+}
+
+impl Measures {
+    pub fn of(kind: BenchmarkKind) -> Measures {
+        if kind.is_reconstruction() {
+            Measures {
+                fields: &RECONSTRUCTION_FIELDS,
+                norms: &RECONSTRUCTION_NORMS,
+            }
+        } else {
+            Measures {
+                fields: &ERROR_FIELDS,
+                norms: &NORMS,
+            }
+        }
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RunStatus {
@@ -61,14 +90,18 @@ pub struct RunSummary {
     pub axes: Params,
     /// Final error norms keyed by (field, norm), e.g. ("velocity", "l2").
     pub final_norms: BTreeMap<(String, String), f64>,
+    /// The `/reconstruction` group of a reconstruction run, which its figures and tables show.
+    pub reconstruction: Option<ReconstructionRecord>,
 }
 
 mod atomic;
 mod reader;
+mod reconstruction;
 mod record;
 mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
 pub use reader::read_summary;
+pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{Conservation, Diagnostics, Errors, History, ParticleTable, RunRecord};
 pub use writer::write_hdf5;

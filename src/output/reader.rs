@@ -4,24 +4,27 @@ use std::path::Path;
 use hdf5::types::{TypeDescriptor, VarLenUnicode};
 use hdf5::Location;
 
-use super::{RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use super::{reconstruction, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use super::{RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
 use crate::params::{ParamValue, Params};
 
-/// Reads what the report needs from one run file.
+/// Reads what the report needs from one run file. A reconstruction run has no time steps:
+/// its `steps` is 0 and its `dt` NaN.
 pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let context = |e: hdf5::Error| format!("{}: {e}", path.display());
     let file = hdf5::File::open(path).map_err(context)?;
     let status_text = read_str(&file, "status").map_err(context)?;
     let status = RunStatus::parse(&status_text)
         .ok_or_else(|| format!("{}: unknown status '{status_text}'", path.display()))?;
-    let norms = file.group("errors/norms").map_err(context)?;
-    let mut final_norms = BTreeMap::new();
-    for field in ERROR_FIELDS {
-        for norm in NORMS {
-            let value = read_f64(&norms, &format!("{norm}_{field}")).map_err(context)?;
-            final_norms.insert((field.to_string(), norm.to_string()), value);
-        }
-    }
+    let reconstruction = reconstruction::read(&file).map_err(context)?;
+    let (final_norms, steps, dt) = match &reconstruction {
+        Some(r) => (reconstruction_norms(r.l2, r.max), 0, f64::NAN),
+        None => (
+            simulation_norms(&file).map_err(context)?,
+            read_i64(&file, "steps").map_err(context)? as usize,
+            read_f64(&file, "dt").map_err(context)?,
+        ),
+    };
     let matrix = file.group("matrix").map_err(context)?;
     Ok(RunSummary {
         run_id: read_str(&file, "run_id").map_err(context)?,
@@ -32,14 +35,38 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         cells: read_i64(&file, "cells").map_err(context)? as usize,
         ppc: read_i64(&file, "ppc").map_err(context)? as usize,
         h: read_f64(&file, "h").map_err(context)?,
-        dt: read_f64(&file, "dt").map_err(context)?,
-        steps: read_i64(&file, "steps").map_err(context)? as usize,
+        dt,
+        steps,
         status,
         message: read_str(&file, "message").map_err(context)?,
         wall_seconds: read_f64(&file, "wall_seconds").map_err(context)?,
         axes: read_params(&matrix).map_err(context)?,
         final_norms,
+        reconstruction,
     })
+}
+
+type FinalNorms = BTreeMap<(String, String), f64>;
+
+fn simulation_norms(file: &hdf5::File) -> hdf5::Result<FinalNorms> {
+    let norms = file.group("errors/norms")?;
+    let mut final_norms = BTreeMap::new();
+    for field in ERROR_FIELDS {
+        for norm in NORMS {
+            let value = read_f64(&norms, &format!("{norm}_{field}"))?;
+            final_norms.insert((field.to_string(), norm.to_string()), value);
+        }
+    }
+    Ok(final_norms)
+}
+
+fn reconstruction_norms(l2: f64, max: f64) -> FinalNorms {
+    let [field] = RECONSTRUCTION_FIELDS;
+    RECONSTRUCTION_NORMS
+        .into_iter()
+        .zip([l2, max])
+        .map(|(norm, value)| ((field.to_string(), norm.to_string()), value))
+        .collect()
 }
 
 /// Attributes of a group as parameter values, typed as they were written.
@@ -49,7 +76,10 @@ fn read_params(loc: &Location) -> hdf5::Result<Params> {
         let attr = loc.attr(&name)?;
         let value = match attr.dtype()?.to_descriptor()? {
             TypeDescriptor::Integer(_) => ParamValue::Int(attr.read_scalar::<i64>()?),
-            TypeDescriptor::Float(_) => ParamValue::Float(attr.read_scalar::<f64>()?),
+            TypeDescriptor::Float(_) if attr.is_scalar() => {
+                ParamValue::Float(attr.read_scalar::<f64>()?)
+            }
+            TypeDescriptor::Float(_) => ParamValue::List(attr.read_raw::<f64>()?),
             _ => ParamValue::Str(attr.read_scalar::<VarLenUnicode>()?.to_string()),
         };
         params.insert(name, value);
@@ -57,14 +87,14 @@ fn read_params(loc: &Location) -> hdf5::Result<Params> {
     Ok(params)
 }
 
-fn read_str(loc: &Location, name: &str) -> hdf5::Result<String> {
+pub(super) fn read_str(loc: &Location, name: &str) -> hdf5::Result<String> {
     Ok(loc.attr(name)?.read_scalar::<VarLenUnicode>()?.to_string())
 }
 
-fn read_f64(loc: &Location, name: &str) -> hdf5::Result<f64> {
+pub(super) fn read_f64(loc: &Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
 }
 
-fn read_i64(loc: &Location, name: &str) -> hdf5::Result<i64> {
+pub(super) fn read_i64(loc: &Location, name: &str) -> hdf5::Result<i64> {
     loc.attr(name)?.read_scalar::<i64>()
 }

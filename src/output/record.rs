@@ -1,4 +1,4 @@
-use super::RunStatus;
+use super::{ReconstructionRecord, RunStatus};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
@@ -24,6 +24,8 @@ pub struct RunRecord {
     pub errors: Errors,
     pub conservation: Conservation,
     pub diagnostics: Diagnostics,
+    /// Set for the runs of reconstruction benchmarks, which have no particles or history.
+    pub reconstruction: Option<ReconstructionRecord>,
 }
 
 /// `/particles`: reference positions (Np x D), masses and initial volumes.

@@ -1,59 +1,34 @@
 use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
-use hdf5::{Group, Location};
+use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
-use super::{RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
+use super::{reconstruction, RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
 use crate::params::ParamValue;
 
 /// Writes the whole record into a new HDF5 file at `path` (which must not exist).
 pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     let file = hdf5::File::create_excl(path)?;
+    write_identity(&file, r)?;
+    if let Some(record) = &r.reconstruction {
+        reconstruction::write(&file, record)?;
+        return file.flush();
+    }
     let d = r.dim;
     let np = r.particles.len();
     let nt = r.history.time.len();
 
-    attr_i64(&file, "schema_version", SCHEMA_VERSION)?;
     for (name, value) in [
-        ("run_id", r.spec.run_id.as_str()),
-        ("experiment", &r.spec.experiment),
-        ("benchmark", &r.spec.benchmark),
-        ("method", &r.spec.method),
-        ("shape", &r.method.shape.to_string()),
-        ("transfer", &r.method.transfer.to_string()),
-        ("integrator", &r.method.integrator.to_string()),
-        ("status", r.status.as_str()),
-        ("message", &r.message),
-        ("config_yaml", &r.spec.config_yaml),
-        ("mpmlab_version", env!("CARGO_PKG_VERSION")),
+        ("shape", r.method.shape.to_string()),
+        ("transfer", r.method.transfer.to_string()),
+        ("integrator", r.method.integrator.to_string()),
     ] {
-        attr_str(&file, name, value)?;
+        attr_str(&file, name, &value)?;
     }
-    for (name, value) in [
-        ("dim", d),
-        ("cells", r.cells),
-        ("ppc", r.ppc),
-        ("steps", r.steps),
-    ] {
-        attr_i64(&file, name, value as i64)?;
-    }
-    for (name, value) in [
-        ("h", r.h),
-        ("dt", r.dt),
-        ("t_end", r.t_end),
-        ("wall_seconds", r.wall_seconds),
-    ] {
+    attr_i64(&file, "steps", r.steps as i64)?;
+    for (name, value) in [("dt", r.dt), ("t_end", r.t_end)] {
         attr_f64(&file, name, value)?;
-    }
-
-    let params = file.create_group("params")?;
-    for (key, value) in &r.spec.params {
-        attr_param(&params, key, value)?;
-    }
-    let matrix = file.create_group("matrix")?;
-    for (key, value) in &r.spec.axes {
-        attr_param(&matrix, key, value)?;
     }
 
     let particles = file.create_group("particles")?;
@@ -63,12 +38,7 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
 
     let history = file.create_group("history")?;
     dataset(&history, "time", &r.history.time, &[nt], "s")?;
-    let steps = ArrayView::from_shape(IxDyn(&[nt]), &r.history.step).map_err(shape_error)?;
-    let ds = history
-        .new_dataset_builder()
-        .with_data(steps)
-        .create("step")?;
-    attr_str(&ds, "units", "1")?;
+    dataset(&history, "step", &r.history.step, &[nt], "1")?;
     dataset(&history, "x", &r.history.x, &[nt, np, d], "m")?;
     dataset(&history, "v", &r.history.v, &[nt, np, d], "m/s")?;
     dataset(&history, "stress", &r.history.stress, &[nt, np, d, d], "Pa")?;
@@ -107,6 +77,39 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     Ok(())
 }
 
+/// What every run file has: the root attributes that identify the run and its outcome, and
+/// the `/params` and `/matrix` groups.
+fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
+    attr_i64(file, "schema_version", SCHEMA_VERSION)?;
+    for (name, value) in [
+        ("run_id", r.spec.run_id.as_str()),
+        ("experiment", &r.spec.experiment),
+        ("benchmark", &r.spec.benchmark),
+        ("method", &r.spec.method),
+        ("status", r.status.as_str()),
+        ("message", &r.message),
+        ("config_yaml", &r.spec.config_yaml),
+        ("mpmlab_version", env!("CARGO_PKG_VERSION")),
+    ] {
+        attr_str(file, name, value)?;
+    }
+    for (name, value) in [("dim", r.dim), ("cells", r.cells), ("ppc", r.ppc)] {
+        attr_i64(file, name, value as i64)?;
+    }
+    for (name, value) in [("h", r.h), ("wall_seconds", r.wall_seconds)] {
+        attr_f64(file, name, value)?;
+    }
+    let params = file.create_group("params")?;
+    for (key, value) in &r.spec.params {
+        attr_param(&params, key, value)?;
+    }
+    let matrix = file.create_group("matrix")?;
+    for (key, value) in &r.spec.axes {
+        attr_param(&matrix, key, value)?;
+    }
+    Ok(())
+}
+
 fn field_unit(field: &str) -> &'static str {
     match field {
         "displacement" => "m",
@@ -120,10 +123,11 @@ fn shape_error(e: ndarray::ShapeError) -> hdf5::Error {
     hdf5::Error::from(format!("array shape: {e}"))
 }
 
-fn dataset(
+/// A dataset of `shape` (row-major `data`) with its `units` attribute.
+pub(super) fn dataset<T: H5Type>(
     group: &Group,
     name: &str,
-    data: &[f64],
+    data: &[T],
     shape: &[usize],
     unit: &str,
 ) -> hdf5::Result<()> {
@@ -137,10 +141,15 @@ fn attr_param(loc: &Location, key: &str, value: &ParamValue) -> hdf5::Result<()>
         ParamValue::Int(i) => attr_i64(loc, key, *i),
         ParamValue::Float(x) => attr_f64(loc, key, *x),
         ParamValue::Str(s) => attr_str(loc, key, s),
+        ParamValue::List(values) => loc
+            .new_attr::<f64>()
+            .shape(values.len())
+            .create(key)?
+            .write_raw(values),
     }
 }
 
-fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+pub(super) fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
     let value: VarLenUnicode = value
         .parse()
         .map_err(|e| hdf5::Error::from(format!("attribute {name}: {e}")))?;
@@ -150,14 +159,14 @@ fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
         .write_scalar(&value)
 }
 
-fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {
+pub(super) fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {
     loc.new_attr::<f64>()
         .shape(())
         .create(name)?
         .write_scalar(&value)
 }
 
-fn attr_i64(loc: &Location, name: &str, value: i64) -> hdf5::Result<()> {
+pub(super) fn attr_i64(loc: &Location, name: &str, value: i64) -> hdf5::Result<()> {
     loc.new_attr::<i64>()
         .shape(())
         .create(name)?

@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use nalgebra::SVector;
+
 /// A 1D weight w(r), r = |x - x_p| / (scale h), in B-spline form.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Weight {
@@ -16,6 +18,26 @@ pub enum Weight {
 }
 
 impl Weight {
+    pub const ALL: [Weight; 3] = [Weight::Hat, Weight::QuadraticSpline, Weight::CubicSpline];
+    /// The names experiment files use, in the order of `ALL`.
+    pub const NAMES: [&'static str; 3] = [
+        Weight::Hat.name(),
+        Weight::QuadraticSpline.name(),
+        Weight::CubicSpline.name(),
+    ];
+
+    pub const fn name(self) -> &'static str {
+        match self {
+            Weight::Hat => "hat",
+            Weight::QuadraticSpline => "quadratic",
+            Weight::CubicSpline => "cubic",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Weight> {
+        Weight::ALL.into_iter().find(|w| w.name() == name)
+    }
+
     /// Support radius in units of the support length.
     pub fn radius(self) -> f64 {
         match self {
@@ -67,15 +89,20 @@ impl Kernel {
     pub fn radius_cells(&self) -> f64 {
         self.weight.radius() * self.scale
     }
+
+    /// Tensor-product weight of the offset `d`, given in units of h.
+    #[inline]
+    pub fn eval<const D: usize>(&self, d: &SVector<f64, D>) -> f64 {
+        let inv = 1.0 / self.scale;
+        d.iter()
+            .map(|&dk| self.weight.eval(dk.abs() * inv))
+            .product()
+    }
 }
 
 impl fmt::Display for Weight {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Weight::Hat => "hat",
-            Weight::QuadraticSpline => "quadratic",
-            Weight::CubicSpline => "cubic",
-        })
+        f.write_str(self.name())
     }
 }
 

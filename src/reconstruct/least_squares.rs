@@ -23,6 +23,15 @@ pub enum Solver {
     Imls,
 }
 
+impl fmt::Display for Solver {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Solver::Mls => "mls",
+            Solver::Imls => "imls",
+        })
+    }
+}
+
 /// Everything that defines a reconstruction except where it is evaluated.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Recipe {
@@ -81,6 +90,10 @@ impl fmt::Display for SingularMoments {
 
 /// Largest number of lattice points one particle reaches along an axis.
 const MAX_PER_AXIS: usize = 32;
+
+/// The widest support radius, in cells, that `Reconstructor::new` accepts on a lattice of
+/// grid nodes: an open interval of 2 x 15 cells meets at most 31 nodes per axis.
+pub const MAX_NODE_SUPPORT_CELLS: f64 = 15.0;
 
 pub struct Reconstructor<const D: usize> {
     recipe: Recipe,

@@ -16,10 +16,12 @@ use nalgebra::SVector;
 pub use basis::{monomials, Degree, MAX_TERMS};
 pub use kernel::{Kernel, Weight};
 pub use lattice::Lattice;
-pub use least_squares::{FitStats, Recipe, Reconstructor, SingularMoments, Solver};
+pub use least_squares::{
+    FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,
+};
 pub use quadrature::{QuadratureRecipe, QuadratureTransfer};
 pub use shepard::particles_to_grid;
-pub use solve::{Moments, OrthogonalBasis, RANK_TOLERANCE};
+pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
 
 /// Nodal quantities assembled from the particles each step.
 pub struct GridState<const D: usize> {

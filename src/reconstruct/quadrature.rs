@@ -130,7 +130,7 @@ mod tests {
         let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
         let mut particles = Particles::seed(&prob, &grid);
-        let mut rng = crate::testing::Lcg::new(99);
+        let mut rng = crate::rng::Lcg::new(99);
         for p in 0..particles.len() {
             particles.stress[p] = SMatrix::from_fn(|_, _| 1e3 * (rng.unit() - 0.5));
             particles.v[p] = SVector::from_fn(|_, _| rng.unit());

@@ -54,7 +54,7 @@ mod tests {
         let prob = problem::<D>();
         let grid = Grid::new(&prob.domain());
         let mut particles = Particles::seed(&prob, &grid);
-        let mut rng = crate::testing::Lcg::new(12345);
+        let mut rng = crate::rng::Lcg::new(12345);
         let mut rand = || rng.unit() - 0.5;
         for p in 0..particles.len() {
             particles.x[p] += SVector::<f64, D>::from_fn(|_, _| 0.05 * rand());

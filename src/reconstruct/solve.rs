@@ -4,7 +4,10 @@
 //! (Tran eq 16) and needs no inversion (eq 11), dropping the polynomials the data cannot
 //! support (eq 17).
 
-use super::basis::MAX_TERMS;
+use nalgebra::SVector;
+
+use super::basis::{monomials, Degree, MAX_TERMS};
+use super::kernel::Kernel;
 
 /// A polynomial is dropped (IMLS) or the moment matrix declared singular (MLS) when the part
 /// of it the data can see is at most this fraction of its weighted norm. For IMLS the ratio
@@ -16,6 +19,28 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 
 /// Row-major m x m moment matrix, m <= MAX_TERMS.
 pub type Moments = [f64; MAX_TERMS * MAX_TERMS];
+
+/// The moment matrix A = sum_p w(d_p) q(d_p) q(d_p)^T of the offsets d_p = (x_p - x)/h of the
+/// data from one evaluation point x, and the number of basis terms.
+pub fn moment_matrix<const D: usize>(
+    kernel: &Kernel,
+    degree: Degree,
+    offsets: &[SVector<f64, D>],
+) -> (Moments, usize) {
+    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
+    let mut q = [0.0; MAX_TERMS];
+    let terms = degree.terms(D);
+    for d in offsets {
+        let w = kernel.eval(d);
+        monomials(degree, d, &mut q);
+        for r in 0..terms {
+            for s in 0..terms {
+                a[r * MAX_TERMS + s] += w * q[r] * q[s];
+            }
+        }
+    }
+    (a, terms)
+}
 
 /// The weighted orthogonal polynomials p_i = sum_j coeffs[i][j] q_j of Tran eq 16, built
 /// from the inner products <q_i, q_j> = A_ij (eq 7).

@@ -4,8 +4,8 @@ use nalgebra::SVector;
 
 use super::*;
 use crate::benchmarks::Domain;
+use crate::rng::Lcg;
 use crate::shape::Grid;
-use crate::testing::Lcg;
 
 fn grid<const D: usize>(cells: usize) -> Grid<D> {
     Grid::new(&Domain {
@@ -199,17 +199,15 @@ fn imls_degrades_to_the_rank_of_the_data() {
 #[test]
 fn two_points_make_the_quadratic_polynomial_vanish() {
     let xs = [-0.6, 0.4];
-    let w = |x: f64| Weight::QuadraticSpline.eval(x.abs() / 2.0);
-    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
+    let kernel = Kernel {
+        weight: Weight::QuadraticSpline,
+        scale: 2.0,
+    };
+    let w = |x: f64| kernel.eval(&SVector::<f64, 1>::from([x]));
+    let offsets: Vec<SVector<f64, 1>> = xs.iter().map(|&x| SVector::from([x])).collect();
+    let (a, terms) = moment_matrix(&kernel, Degree::QUADRATIC, &offsets);
+    assert_eq!(terms, 3);
     let mut q = [0.0; MAX_TERMS];
-    for &x in &xs {
-        monomials(Degree::QUADRATIC, &SVector::<f64, 1>::from([x]), &mut q);
-        for r in 0..3 {
-            for s in 0..3 {
-                a[r * MAX_TERMS + s] += w(x) * q[r] * q[s];
-            }
-        }
-    }
     let basis = OrthogonalBasis::from_moments(&a, 3);
     assert!(!basis.kept[2]);
     assert!(basis.norms[2].abs() < 1e-15 * a[2 * MAX_TERMS + 2]);
@@ -231,6 +229,24 @@ fn two_points_make_the_quadratic_polynomial_vanish() {
         })
         .sum();
     assert!((u0 - 2.0).abs() < 1e-14);
+}
+
+/// The widest support the node lattice accepts is accepted: benchmarks check against it.
+#[test]
+fn the_widest_node_support_fits() {
+    let kernel = Kernel {
+        weight: Weight::Hat,
+        scale: MAX_NODE_SUPPORT_CELLS,
+    };
+    let mut rec = Reconstructor::new(
+        Recipe {
+            kernel,
+            degree: Degree::CONSTANT,
+            solver: Solver::Mls,
+        },
+        Lattice::nodes(&grid::<1>(4)),
+    );
+    assert_eq!(rec.fit(&[SVector::from([0.3])]).unwrap().fits, 5);
 }
 
 /// A reconstruction with too few points counts its rank losses (IMLS) or stops (MLS).

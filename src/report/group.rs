@@ -105,14 +105,23 @@ fn cmp_params(a: &Params, b: &Params) -> Ordering {
         .unwrap_or_else(|| a.len().cmp(&b.len()))
 }
 
-/// Numbers before strings; numbers by value, strings lexically.
+/// Numbers before strings; numbers by value, strings lexically, lists of numbers element by
+/// element.
 fn cmp_value(a: &ParamValue, b: &ParamValue) -> Ordering {
     match (a.as_f64(), b.as_f64(), a.as_str(), b.as_str()) {
         (Some(x), Some(y), _, _) => x.total_cmp(&y),
         (Some(_), None, _, _) => Ordering::Less,
         (None, Some(_), _, _) => Ordering::Greater,
         (_, _, Some(x), Some(y)) => x.cmp(y),
-        _ => Ordering::Equal,
+        _ => match (a.as_list(), b.as_list()) {
+            (Some(x), Some(y)) => x
+                .iter()
+                .zip(y)
+                .map(|(p, q)| p.total_cmp(q))
+                .find(|o| o.is_ne())
+                .unwrap_or_else(|| x.len().cmp(&y.len())),
+            _ => Ordering::Equal,
+        },
     }
 }
 
@@ -128,17 +137,18 @@ pub fn usable_points(runs: &[&RunSummary], field: &str, norm: &str) -> Vec<(f64,
         .collect()
 }
 
-/// A file-name-safe version of `text`: characters outside `[A-Za-z0-9._-]` become `_`.
+/// A file-name-safe version of `text`: runs of characters outside `[A-Za-z0-9.-]` become one
+/// `_`, none at the ends (`points=[-0.6, 0.4]` gives `points_-0.6_0.4`).
 pub fn slug(text: &str) -> String {
-    text.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-') {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_ascii_alphanumeric() || matches!(c, '.' | '-') {
+            out.push(c);
+        } else if !out.is_empty() && !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_end_matches('_').to_string()
 }
 
 #[cfg(test)]
@@ -160,6 +170,17 @@ mod tests {
         values.sort_by(cmp_params);
         let labels: Vec<String> = values.iter().map(label).collect();
         assert_eq!(labels, ["G=1.5", "G=2", "G=10.0", "G=b"]);
+        let mut lists = [
+            one("x", ParamValue::List(vec![0.6, 0.75])),
+            one("x", ParamValue::List(vec![-0.6, 0.4, 1.0])),
+            one("x", ParamValue::List(vec![-0.6, 0.4])),
+        ];
+        lists.sort_by(cmp_params);
+        let labels: Vec<String> = lists.iter().map(label).collect();
+        assert_eq!(
+            labels,
+            ["x=[-0.6, 0.4]", "x=[-0.6, 0.4, 1.0]", "x=[0.6, 0.75]"]
+        );
     }
 
     #[test]
@@ -181,5 +202,6 @@ mod tests {
     fn slug_replaces_unsafe_characters() {
         assert_eq!(slug("G=0.1 method=mpm"), "G_0.1_method_mpm");
         assert_eq!(slug("a/b,c-d_e"), "a_b_c-d_e");
+        assert_eq!(slug("points=[-0.6, 0.4]"), "points_-0.6_0.4");
     }
 }

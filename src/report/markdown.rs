@@ -7,6 +7,7 @@ use super::check::{describe, CheckFailure};
 use super::figures::Figure;
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs};
+use super::pointwise::Table;
 use super::RateRow;
 use crate::experiment::Experiment;
 use crate::output::{RunStatus, RunSummary};
@@ -15,15 +16,26 @@ pub fn report_md(
     experiment: &Experiment,
     runs: &[RunSummary],
     rates: &[RateRow],
+    tables: &[Table],
     figures: &[Figure],
     check: Option<&[CheckFailure]>,
 ) -> String {
     let runs = ordered_runs(runs);
     let mut md = format!("# {}\n\n", experiment.name);
+    if !experiment.description.is_empty() {
+        let _ = writeln!(md, "{}\n", experiment.description);
+    }
     overview(&mut md, experiment, &runs);
     runs_table(&mut md, experiment, &runs);
     rates_table(&mut md, rates);
     unfinished(&mut md, &runs);
+    if !tables.is_empty() {
+        md.push_str("## Tables\n\n");
+        for t in tables {
+            let _ = writeln!(md, "### {}\n\n{}\n", t.title, t.note);
+            table(&mut md, &t.header, t.rows.iter().cloned());
+        }
+    }
     if !figures.is_empty() {
         md.push_str("## Figures\n\n");
         for figure in figures {
@@ -62,17 +74,21 @@ fn overview(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
 
 fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
     md.push_str("## Runs\n\n");
+    // Reconstruction runs take no time steps.
+    let stepped = !experiment.kind.is_reconstruction();
     let mut header = vec!["run".to_string()];
     header.extend(experiment.axes.iter().cloned());
-    header.extend(["h", "status", "steps"].map(String::from));
+    header.extend(["h", "status"].map(String::from));
+    if stepped {
+        header.push("steps".into());
+    }
     let rows = runs.iter().map(|run| {
         let mut row = vec![format!("`{}`", run.run_id)];
         row.extend(group::axis_values(experiment, run));
-        row.extend([
-            h_text(run.h),
-            run.status.as_str().to_string(),
-            run.steps.to_string(),
-        ]);
+        row.extend([h_text(run.h), run.status.as_str().to_string()]);
+        if stepped {
+            row.push(run.steps.to_string());
+        }
         row
     });
     table(md, &header, rows);

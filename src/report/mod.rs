@@ -11,6 +11,7 @@ mod format;
 mod group;
 mod markdown;
 mod plot;
+mod pointwise;
 mod tables;
 
 use std::fs;
@@ -20,7 +21,7 @@ use std::path::{Path, PathBuf};
 pub use check::{check, CheckFailure};
 
 use crate::experiment::Experiment;
-use crate::output::{RunSummary, ERROR_FIELDS, NORMS};
+use crate::output::{Measures, RunSummary};
 use crate::params::Params;
 
 /// The fitted convergence rate of one (group, field, norm): `log10(error) = intercept +
@@ -71,7 +72,8 @@ pub fn write_report(
     for figure in &figures {
         plot::render(&dir.join(&figure.file), figure)?;
     }
-    let md = markdown::report_md(experiment, runs, rates, &figures, check);
+    let tables = pointwise::tables(experiment, runs);
+    let md = markdown::report_md(experiment, runs, rates, &tables, &figures, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report {
         figures: figures.into_iter().map(|f| f.file).collect(),
@@ -93,12 +95,13 @@ fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::R
 }
 
 /// Fits every (group, field, norm) with at least two finished runs of positive, finite
-/// error, sorted by group, then field and norm in `ERROR_FIELDS` and `NORMS` order.
+/// error, sorted by group, then field and norm in the order of the experiment's measures.
 pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
+    let measures = Measures::of(experiment.kind);
     let mut rows = Vec::new();
     for g in group::group_runs(runs, &[group::REFINEMENT_AXIS]) {
-        for field in ERROR_FIELDS {
-            for norm in NORMS {
+        for &field in measures.fields {
+            for &norm in measures.norms {
                 let points = group::usable_points(&g.runs, field, norm);
                 let Some(line) = fit::fit_loglog(&points) else {
                     continue;

@@ -1,17 +1,21 @@
-//! Draws a convergence figure to PNG with plotters. Text uses the embedded DejaVu font, so
-//! rendering needs no system fonts and gives the same bytes on every machine.
+//! Draws a figure to PNG with plotters: log-log convergence plots and linear plots of
+//! reconstructed functions. Text uses the embedded DejaVu font, so rendering needs no system
+//! fonts and gives the same bytes on every machine.
 
 use std::io;
 use std::path::Path;
 use std::sync::Once;
 
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
 
-use super::figures::Figure;
+use super::figures::{Figure, Marker, Scale, Series};
 use super::fit::min_max;
+use super::format::general;
 
 /// Width and height of the axes part of the image; the legend adds rows below it, so many
 /// curves make a taller image rather than squeezed axes.
@@ -35,6 +39,8 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(0, 0, 0),
     RGBColor(120, 120, 120),
 ];
+/// Half the side of a square marker and the radius of a circle, in pixels.
+const MARKER_SIZE: i32 = 4;
 
 fn register_fonts() {
     static ONCE: Once = Once::new();
@@ -45,8 +51,8 @@ fn register_fonts() {
     });
 }
 
-/// Writes `figure` as a PNG: error against h on log-log axes, markers per curve and its
-/// fitted power law dashed, with the legend below the axes so it never hides data.
+/// Writes `figure` as a PNG: each series' markers and its line (dashed for fits), with the
+/// legend below the axes so it never hides data.
 pub fn render(path: &Path, figure: &Figure) -> io::Result<()> {
     register_fonts();
     draw(path, figure).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
@@ -57,7 +63,7 @@ type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
 fn draw(path: &Path, figure: &Figure) -> DrawResult {
     let columns = legend_columns(figure);
-    let rows = figure.curves.len().div_ceil(columns) as u32;
+    let rows = figure.series.len().div_ceil(columns) as u32;
     let height = AXES_HEIGHT + rows * LEGEND_ROW + MARGIN / 2;
     let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
     root.fill(&WHITE)?;
@@ -70,58 +76,100 @@ fn draw(path: &Path, figure: &Figure) -> DrawResult {
 
 fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
     let data: Vec<(f64, f64)> = figure
-        .curves
+        .series
         .iter()
-        .flat_map(|c| c.points.iter().copied())
+        .flat_map(|s| s.markers.iter().chain(&s.line).copied())
         .collect();
-    let (x_lo, x_hi) = padded_range(data.iter().map(|p| p.0));
-    let (y_lo, y_hi) = padded_range(data.iter().map(|p| p.1));
-    let (x_major, x_minor) = log_ticks(x_lo, x_hi);
-    let (y_major, y_minor) = log_ticks(y_lo, y_hi);
-
-    let mut chart = ChartBuilder::on(area)
+    let xs = data.iter().map(|p| p.0);
+    let ys = data.iter().map(|p| p.1);
+    let mut builder = ChartBuilder::on(area);
+    builder
         .caption(&figure.title, (FONT, 22).into_font().style(FontStyle::Bold))
         .margin(MARGIN)
         .x_label_area_size(55)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(
-            (x_lo..x_hi)
-                .log_scale()
-                .with_key_points(x_major)
-                .with_light_points(x_minor),
-            (y_lo..y_hi)
-                .log_scale()
-                .with_key_points(y_major)
-                .with_light_points(y_minor),
-        )?;
+        .y_label_area_size(Y_LABEL_AREA);
+    match figure.scale {
+        Scale::LogLog => {
+            let (x_lo, x_hi) = padded_log_range(xs);
+            let (y_lo, y_hi) = padded_log_range(ys);
+            let (x_major, x_minor) = log_ticks(x_lo, x_hi);
+            let (y_major, y_minor) = log_ticks(y_lo, y_hi);
+            let chart = builder.build_cartesian_2d(
+                (x_lo..x_hi)
+                    .log_scale()
+                    .with_key_points(x_major)
+                    .with_light_points(x_minor),
+                (y_lo..y_hi)
+                    .log_scale()
+                    .with_key_points(y_major)
+                    .with_light_points(y_minor),
+            )?;
+            let label = |v: &f64| tick_label(*v);
+            draw_series(chart, figure, &label, &label)
+        }
+        Scale::Linear => {
+            let x_range = padded_linear_range(xs);
+            let y_range = padded_linear_range(ys);
+            let chart: ChartContext<_, Cartesian2d<RangedCoordf64, RangedCoordf64>> =
+                builder.build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
+            let x_label = |v: &f64| linear_tick_label(*v, x_range);
+            let y_label = |v: &f64| linear_tick_label(*v, y_range);
+            draw_series(chart, figure, &x_label, &y_label)
+        }
+    }
+}
+
+/// The mesh with its labels, then every series: markers, and the line through its own points
+/// (dashed for a fit: a solid line through the markers would hide it where data follow it).
+fn draw_series<X, Y>(
+    mut chart: ChartContext<'_, BitMapBackend<'_>, Cartesian2d<X, Y>>,
+    figure: &Figure,
+    x_label: &dyn Fn(&f64) -> String,
+    y_label: &dyn Fn(&f64) -> String,
+) -> DrawResult
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
     chart
         .configure_mesh()
-        .x_desc("h (cell size)")
+        .x_desc(&figure.x_label)
         .y_desc(&figure.y_label)
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
+        .x_label_formatter(x_label)
+        .y_label_formatter(y_label)
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 18))
         .bold_line_style(BLACK.mix(0.25))
         .light_line_style(BLACK.mix(0.08))
         .draw()?;
-
-    // Markers for the runs and a dashed line for the fit: a line through the markers
-    // would hide the fit wherever the data follow it.
-    for (i, curve) in figure.curves.iter().enumerate() {
+    for (i, series) in figure.series.iter().enumerate() {
         let style = curve_style(i);
-        chart.draw_series(curve.points.iter().map(|&p| Circle::new(p, 4, style)))?;
-        if let Some(fit) = curve.fit {
-            let (h_lo, h_hi) = min_max(curve.points.iter().map(|p| p.0));
-            let ends = [h_lo, h_hi].map(|h| (h, fit.eval(h)));
-            chart.draw_series(DashedLineSeries::new(ends, 8, 5, style))?;
+        if series.dashed {
+            chart.draw_series(DashedLineSeries::new(series.line.clone(), 8, 5, style))?;
+        } else if !series.line.is_empty() {
+            chart.draw_series(LineSeries::new(series.line.clone(), style))?;
+        }
+        let points = series.markers.iter().copied();
+        match series.marker {
+            Marker::Circle => {
+                chart.draw_series(points.map(|p| Circle::new(p, MARKER_SIZE, style)))?;
+            }
+            Marker::Square => {
+                chart.draw_series(points.map(|p| EmptyElement::at(p) + square((0, 0), style)))?;
+            }
         }
     }
     Ok(())
 }
 
+/// A square marker centred on `c` in pixels.
+fn square(c: (i32, i32), style: ShapeStyle) -> Rectangle<(i32, i32)> {
+    let s = MARKER_SIZE;
+    Rectangle::new([(c.0 - s, c.1 - s), (c.0 + s, c.1 + s)], style)
+}
+
 fn legend_columns(figure: &Figure) -> usize {
-    let longest = figure.curves.iter().map(|c| c.label.chars().count()).max();
+    let longest = figure.series.iter().map(|c| c.label.chars().count()).max();
     if longest.unwrap_or(0) > LEGEND_COLUMN_CHARS {
         1
     } else {
@@ -134,17 +182,27 @@ fn draw_legend(area: &Area, figure: &Figure, columns: usize) -> DrawResult {
     let left = (MARGIN + Y_LABEL_AREA) as i32;
     let column_width = (WIDTH - MARGIN - Y_LABEL_AREA - MARGIN) as i32 / columns as i32;
     let font = TextStyle::from((FONT, 16).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
-    for (i, curve) in figure.curves.iter().enumerate() {
+    for (i, series) in figure.series.iter().enumerate() {
         let style = curve_style(i);
         let x = left + (i % columns) as i32 * column_width;
         let y = ((i / columns) as u32 * LEGEND_ROW + LEGEND_ROW / 2) as i32;
-        area.draw(
-            &(EmptyElement::at((x, y))
-                + PathElement::new([(0, 0), (7, 0)], style)
-                + PathElement::new([(17, 0), (24, 0)], style)
-                + Circle::new((12, 0), 4, style)
-                + Text::new(curve.label.clone(), (34, 0), font.clone())),
-        )?;
+        draw_glyph(area, series, (x, y), style)?;
+        area.draw(&Text::new(series.label.clone(), (x + 34, y), font.clone()))?;
+    }
+    Ok(())
+}
+
+/// A short line where the series has one, broken by its marker where it has markers.
+fn draw_glyph(area: &Area, series: &Series, (x, y): (i32, i32), style: ShapeStyle) -> DrawResult {
+    let segment = |from: i32, to: i32| PathElement::new([(x + from, y), (x + to, y)], style);
+    if !series.line.is_empty() {
+        area.draw(&segment(0, 7))?;
+        area.draw(&segment(17, 24))?;
+    }
+    match (series.markers.is_empty(), series.marker) {
+        (true, _) => area.draw(&segment(7, 17))?,
+        (false, Marker::Circle) => area.draw(&Circle::new((x + 12, y), MARKER_SIZE, style))?,
+        (false, Marker::Square) => area.draw(&square((x + 12, y), style))?,
     }
     Ok(())
 }
@@ -155,10 +213,36 @@ fn curve_style(index: usize) -> ShapeStyle {
 
 /// The data range widened by a tenth of its log span on each side (at least a tenth of a
 /// decade), so markers never sit on the frame; a single value still gets a visible range.
-fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+fn padded_log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = min_max(values);
     let pad = ((hi / lo).log10() * 0.1).max(0.1);
     (lo / 10f64.powf(pad), hi * 10f64.powf(pad))
+}
+
+/// The finite data range widened by 5 % on each side; a range flat to rounding (a reproduced
+/// constant) is widened to +/- 10 % of its value, or +/- 0.1 around 0.
+fn padded_linear_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = min_max(values.filter(|v| v.is_finite()));
+    // No finite value at all: any range will do.
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let size = lo.abs().max(hi.abs());
+    if hi - lo <= 1e-9 * size.max(1e-300) {
+        let pad = if size > 0.0 { 0.1 * size } else { 0.1 };
+        return (lo - pad, hi + pad);
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// A linear tick: three significant digits, and 0 for a tick that is zero up to rounding.
+fn linear_tick_label(v: f64, (lo, hi): (f64, f64)) -> String {
+    if v.abs() <= 1e-9 * (hi - lo) {
+        "0".into()
+    } else {
+        general(v, 3)
+    }
 }
 
 /// Labelled ticks and unlabelled grid lines for a log axis over [lo, hi]. Powers of ten are
@@ -237,7 +321,18 @@ mod tests {
 
     #[test]
     fn padding_keeps_points_inside() {
-        let (lo, hi) = padded_range([0.5, 0.5].into_iter());
+        let (lo, hi) = padded_log_range([0.5, 0.5].into_iter());
         assert!(lo < 0.5 && hi > 0.5);
+        let (lo, hi) = padded_linear_range([1.0, 1.0 + 1e-16].into_iter());
+        assert!(lo < 0.95 && hi > 1.05, "{lo} {hi}");
+        assert_eq!(padded_linear_range([0.0, 0.0].into_iter()), (-0.1, 0.1));
+        let (lo, hi) = padded_linear_range([-1.0, f64::NAN, 1.0].into_iter());
+        assert!((lo + 1.1).abs() < 1e-12 && (hi - 1.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn linear_ticks_hide_rounding() {
+        assert_eq!(linear_tick_label(2.7e-17, (-1.0, 1.0)), "0");
+        assert_eq!(linear_tick_label(0.25, (-1.0, 1.0)), "0.25");
     }
 }

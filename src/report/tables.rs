@@ -6,7 +6,7 @@ use super::format::exact;
 use super::group::{self, ordered_runs};
 use super::RateRow;
 use crate::experiment::Experiment;
-use crate::output::{RunSummary, ERROR_FIELDS, NORMS};
+use crate::output::{Measures, RunSummary};
 
 const RATE_COLUMNS: [&str; 10] = [
     "experiment",
@@ -21,26 +21,31 @@ const RATE_COLUMNS: [&str; 10] = [
     "h_max",
 ];
 
-/// One run per row, grouped and coarsest first: identity, matrix values, status, every
-/// final error norm, then the message (last, as it is the field most likely to need quoting).
+/// One run per row, grouped and coarsest first: identity, matrix values, status, time steps
+/// (for simulations), every final error norm, then the message (last, as it is the field
+/// most likely to need quoting).
 pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
+    let stepped = !experiment.kind.is_reconstruction();
+    let measures = Measures::of(experiment.kind);
     let mut header: Vec<String> = vec!["run_id".into()];
     header.extend(experiment.axes.iter().cloned());
-    header.extend(["h", "status", "steps", "dt", "wall_seconds"].map(String::from));
-    header.extend(norm_columns().map(|(field, norm)| format!("{norm}_{field}")));
+    header.extend(["h", "status"].map(String::from));
+    if stepped {
+        header.extend(["steps", "dt"].map(String::from));
+    }
+    header.push("wall_seconds".into());
+    header.extend(norm_columns(measures).map(|(field, norm)| format!("{norm}_{field}")));
     header.push("message".into());
 
     let rows = ordered_runs(runs).into_iter().map(|run| {
         let mut row = vec![run.run_id.clone()];
         row.extend(group::axis_values(experiment, run));
-        row.extend([
-            exact(run.h),
-            run.status.as_str().to_string(),
-            run.steps.to_string(),
-            exact(run.dt),
-            exact(run.wall_seconds),
-        ]);
-        row.extend(norm_columns().map(|(field, norm)| {
+        row.extend([exact(run.h), run.status.as_str().to_string()]);
+        if stepped {
+            row.extend([run.steps.to_string(), exact(run.dt)]);
+        }
+        row.push(exact(run.wall_seconds));
+        row.extend(norm_columns(measures).map(|(field, norm)| {
             run.final_norms
                 .get(&(field.to_string(), norm.to_string()))
                 .map(|&e| exact(e))
@@ -70,11 +75,12 @@ pub fn rates_csv(rates: &[RateRow]) -> String {
     csv(&RATE_COLUMNS.map(String::from), rows)
 }
 
-/// (field, norm) pairs, norm-major: all l2 columns, then all rms columns.
-fn norm_columns() -> impl Iterator<Item = (&'static str, &'static str)> {
-    NORMS
-        .into_iter()
-        .flat_map(|norm| ERROR_FIELDS.map(|field| (field, norm)))
+/// (field, norm) pairs, norm-major: all l2 columns, then all rms (or max) columns.
+fn norm_columns(measures: Measures) -> impl Iterator<Item = (&'static str, &'static str)> {
+    measures
+        .norms
+        .iter()
+        .flat_map(move |&norm| measures.fields.iter().map(move |&field| (field, norm)))
 }
 
 fn csv(header: &[String], rows: impl IntoIterator<Item = Vec<String>>) -> String {

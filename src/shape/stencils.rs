@@ -72,7 +72,7 @@ mod tests {
 
     /// Deterministic pseudo-random points in the grid (no RNG dependency needed).
     fn points<const D: usize>(n: usize) -> Vec<SVector<f64, D>> {
-        let mut rng = crate::testing::Lcg::new(0x9e3779b97f4a7c15);
+        let mut rng = crate::rng::Lcg::new(0x9e3779b97f4a7c15);
         (0..n)
             .map(|_| SVector::from_fn(|_, _| -0.5 + 2.0 * rng.unit()))
             .collect()

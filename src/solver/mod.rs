@@ -1,5 +1,7 @@
-//! One run: build the problem, seed particles, step, sample, and return the record.
+//! One run: build the problem, seed particles, step, sample, and return the record. Runs of
+//! reconstruction benchmarks, which do not step, go to `reconstruction`.
 
+mod reconstruction;
 mod recorder;
 mod transfer;
 
@@ -23,13 +25,24 @@ use transfer::Transfer;
 /// `failed`, a run that blows up is `diverged`, each with the reason in `message`.
 pub fn simulate(spec: &RunSpec) -> RunRecord {
     let started = Instant::now();
-    let mut record = match prepare(spec) {
-        Ok((method, AnyProblem::D1(problem))) => run_with_method(spec, method, problem),
-        Ok((method, AnyProblem::D2(problem))) => run_with_method(spec, method, problem),
-        Err(message) => base_record(spec, message),
+    let is_reconstruction = benchmarks::info(&spec.benchmark)
+        .is_some_and(|info| benchmarks::kind(info).is_reconstruction());
+    let mut record = if is_reconstruction {
+        reconstruction::evaluate(spec)
+    } else {
+        step(spec)
     };
     record.wall_seconds = started.elapsed().as_secs_f64();
     record
+}
+
+/// A simulation: the problem stepped to its final time by the method.
+fn step(spec: &RunSpec) -> RunRecord {
+    match prepare(spec) {
+        Ok((method, AnyProblem::D1(problem))) => run_with_method(spec, method, problem),
+        Ok((method, AnyProblem::D2(problem))) => run_with_method(spec, method, problem),
+        Err(message) => base_record(spec, message),
+    }
 }
 
 fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
@@ -283,5 +296,6 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         errors: Default::default(),
         conservation: Default::default(),
         diagnostics: Default::default(),
+        reconstruction: None,
     }
 }

@@ -1,0 +1,85 @@
+//! What `figures` and `tables` items share: a required `kind`, one of a list and one whose
+//! data the benchmark's runs record, their own keys, and axis values selecting runs.
+
+use crate::benchmarks::BenchmarkKind;
+use crate::params::Params;
+
+use super::error::ConfigError;
+use super::select::selection;
+use super::space::ParamSpace;
+use super::values::pick;
+use super::yaml::{child_field, read_list, require, Entry, Node};
+
+/// Named kinds of a `what` (figure, table), the keys its items take besides axis values, and
+/// which benchmarks record what each kind shows.
+pub(crate) struct Kinds<K: 'static> {
+    pub what: &'static str,
+    pub kinds: &'static [(&'static str, K)],
+    pub keys: &'static [&'static str],
+    pub suits: fn(&K, BenchmarkKind) -> bool,
+}
+
+/// One item of the list, read as far as all kinds go.
+pub(crate) struct Item<'a, K: 'static> {
+    pub node: &'a Node,
+    /// Its path, e.g. `figures[2]`.
+    pub parent: &'a str,
+    pub entries: Vec<Entry<'a>>,
+    pub kind: &'static K,
+    pub select: Params,
+}
+
+impl<K> Kinds<K> {
+    /// The items of an optional list section, each finished by `read`.
+    pub fn read_list<T>(
+        &self,
+        section: Option<&Entry>,
+        space: &ParamSpace,
+        benchmark: BenchmarkKind,
+        read: impl Fn(Item<K>) -> Result<T, ConfigError>,
+    ) -> Result<Vec<T>, ConfigError> {
+        read_list(section, |node, parent| {
+            let entries = node.entries(parent)?;
+            let select = selection(&entries, parent, space, self.keys)?;
+            let kind = self.kind(&entries, node, parent, benchmark)?;
+            read(Item {
+                node,
+                parent,
+                entries,
+                kind,
+                select,
+            })
+        })
+    }
+
+    /// The kind named by the required `kind` entry of the map `node` at `parent`.
+    fn kind(
+        &self,
+        entries: &[Entry],
+        node: &Node,
+        parent: &str,
+        benchmark: BenchmarkKind,
+    ) -> Result<&'static K, ConfigError> {
+        let names = self.kinds.iter().map(|(name, _)| *name);
+        let entry = require(entries, "kind", node.pos, parent).map_err(|e| e.with_valid(names))?;
+        let field = child_field(parent, "kind");
+        let what = format!("{} kind", self.what);
+        let (name, kind) = pick(entry.value, &field, &what, self.kinds, |(name, _)| name)?;
+        if (self.suits)(kind, benchmark) {
+            return Ok(kind);
+        }
+        let suitable = self
+            .kinds
+            .iter()
+            .filter(|(_, k)| (self.suits)(k, benchmark));
+        Err(ConfigError::at(
+            entry.value.pos,
+            field,
+            format!(
+                "a {name} {} needs data that {benchmark} benchmarks do not record",
+                self.what
+            ),
+        )
+        .with_valid(suitable.map(|(name, _)| name)))
+    }
+}

@@ -1,0 +1,74 @@
+//! `tables` entries: the tables of pointwise values that report.md prints beside the rates
+//! (the reconstruction benchmarks' counterparts of Gong's Tables 4.1-4.2 and of the
+//! <p_i, p_i> of Tran's Figs 1-3).
+
+use crate::benchmarks::BenchmarkKind;
+
+use super::error::ConfigError;
+use super::kinds::{Item, Kinds};
+use super::select::axis_key;
+use super::space::ParamSpace;
+use super::yaml::{child_field, find, Entry};
+use super::{TableKind, TableSpec};
+
+const KINDS: Kinds<TableKind> = Kinds {
+    what: "table",
+    kinds: &[
+        ("nodal_errors", TableKind::NodalErrors),
+        ("basis_norms", TableKind::BasisNorms),
+    ],
+    keys: &["kind", "columns"],
+    suits: lists_for,
+};
+
+pub(crate) fn read(
+    section: Option<&Entry>,
+    space: &ParamSpace,
+    benchmark: BenchmarkKind,
+) -> Result<Vec<TableSpec>, ConfigError> {
+    KINDS.read_list(section, space, benchmark, |item| table(item, space))
+}
+
+fn table(item: Item<TableKind>, space: &ParamSpace) -> Result<TableSpec, ConfigError> {
+    let Item {
+        node,
+        parent,
+        entries,
+        kind,
+        select,
+    } = item;
+    let columns = match (kind, find(&entries, "columns")) {
+        (TableKind::NodalErrors, Some(e)) => {
+            Some(axis_key(e.value, &child_field(parent, "columns"), space)?)
+        }
+        (TableKind::NodalErrors, None) => {
+            return Err(ConfigError::at(
+                node.pos,
+                child_field(parent, "columns"),
+                "a nodal_errors table needs 'columns': the axis whose runs become its columns",
+            )
+            .with_valid(space.group_axis_names()))
+        }
+        (TableKind::BasisNorms, Some(e)) => {
+            return Err(ConfigError::at(
+                e.key_pos,
+                child_field(parent, "columns"),
+                "a basis_norms table has one row per run and takes no 'columns'",
+            ))
+        }
+        (TableKind::BasisNorms, None) => None,
+    };
+    Ok(TableSpec {
+        kind: kind.clone(),
+        columns,
+        select,
+    })
+}
+
+/// Whether runs of `benchmark` hold what a table of `kind` lists.
+fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
+    match kind {
+        TableKind::NodalErrors => benchmark.is_reconstruction(),
+        TableKind::BasisNorms => benchmark == BenchmarkKind::OrthogonalBasis,
+    }
+}

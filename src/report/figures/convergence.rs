@@ -1,0 +1,83 @@
+//! Convergence figures: error against h on log-log axes, one curve per field (and value of
+//! `by`), each with its fitted power law.
+
+use super::{Figure, Marker, Names, Scale, Series};
+use crate::experiment::{Experiment, FigureSpec};
+use crate::output::RunSummary;
+use crate::report::fit::{fit_loglog, min_max};
+use crate::report::format::rate;
+use crate::report::group::{group_runs, usable_points, REFINEMENT_AXIS};
+
+/// One figure per combination of the axes other than the refinement axis and `by`.
+pub(super) fn figures(
+    experiment: &Experiment,
+    runs: &[&RunSummary],
+    spec: &FigureSpec,
+    names: &mut Names,
+) -> Vec<Figure> {
+    let drop: Vec<&str> = [Some(REFINEMENT_AXIS), spec.by.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    group_runs(runs.iter().copied(), &drop)
+        .into_iter()
+        .filter_map(|group| {
+            let series = curves(&group.runs, spec);
+            if series.is_empty() {
+                return None;
+            }
+            let which = if group.label.is_empty() {
+                "all".to_string()
+            } else {
+                group.label.clone()
+            };
+            let title = if group.label.is_empty() {
+                experiment.name.clone()
+            } else {
+                format!("{}: {}", experiment.name, group.label)
+            };
+            Some(Figure {
+                file: names.file(experiment, &format!("{which}_{}", spec.norm)),
+                title,
+                x_label: "h (cell size)".into(),
+                y_label: format!("{} error", spec.norm),
+                scale: Scale::LogLog,
+                series,
+            })
+        })
+        .collect()
+}
+
+/// One curve per value of `by` (if any) and field, in that order: the runs as markers and
+/// the fit dashed between the coarsest and finest h; empty curves are dropped.
+fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
+    let mut curves = Vec::new();
+    // Within one figure only `by` is left to vary besides the refinement axis.
+    for sub in group_runs(runs.iter().copied(), &[REFINEMENT_AXIS]) {
+        let by = spec
+            .by
+            .as_ref()
+            .and_then(|axis| sub.axes.get(axis).map(|value| format!(", {axis}={value}")))
+            .unwrap_or_default();
+        for field in &spec.fields {
+            let points = usable_points(&sub.runs, field, &spec.norm);
+            if points.is_empty() {
+                continue;
+            }
+            let fit = fit_loglog(&points);
+            let slope = fit.map_or(String::new(), |f| format!(" (rate {})", rate(f.slope)));
+            let line = fit.map_or_else(Vec::new, |f| {
+                let (h_lo, h_hi) = min_max(points.iter().map(|p| p.0));
+                vec![(h_lo, f.eval(h_lo)), (h_hi, f.eval(h_hi))]
+            });
+            curves.push(Series {
+                label: format!("{field}{by}{slope}"),
+                markers: points,
+                marker: Marker::Circle,
+                line,
+                dashed: true,
+            });
+        }
+    }
+    curves
+}

@@ -1,0 +1,125 @@
+//! Which figures a report draws and what goes into each; drawing is `plot`'s job.
+
+mod convergence;
+mod profiles;
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+use super::group::{selects, slug};
+use crate::experiment::{Experiment, FigureKind, FigureSpec};
+use crate::output::{Measures, RunSummary};
+use crate::params::Params;
+
+/// How the axes of a figure are scaled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    /// log10 on both axes (convergence figures).
+    LogLog,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    Circle,
+    Square,
+}
+
+/// One legend entry: markers at some points and a line through others, in one colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    pub label: String,
+    pub markers: Vec<(f64, f64)>,
+    pub marker: Marker,
+    pub line: Vec<(f64, f64)>,
+    pub dashed: bool,
+}
+
+impl Series {
+    pub fn markers(label: String, marker: Marker, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label,
+            markers: points,
+            marker,
+            line: Vec::new(),
+            dashed: false,
+        }
+    }
+
+    pub fn line(label: String, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label,
+            markers: Vec::new(),
+            marker: Marker::Circle,
+            line: points,
+            dashed: false,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Figure {
+    /// Relative to the report directory.
+    pub file: PathBuf,
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub scale: Scale,
+    pub series: Vec<Series>,
+}
+
+/// Every figure of the report: the experiment's own, or one convergence figure per group
+/// with all fields in the first norm when it asks for none. Figures without a single
+/// usable point are left out.
+pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
+    let measures = Measures::of(experiment.kind);
+    let default = [FigureSpec {
+        kind: FigureKind::Convergence,
+        fields: measures.fields.iter().map(|f| f.to_string()).collect(),
+        norm: measures.norms[0].to_string(),
+        by: None,
+        select: Params::new(),
+    }];
+    let specs = if experiment.figures.is_empty() {
+        &default[..]
+    } else {
+        &experiment.figures
+    };
+    let mut names = Names::default();
+    let mut figures = Vec::new();
+    for spec in specs {
+        let selected: Vec<&RunSummary> = runs
+            .iter()
+            .filter(|run| selects(&spec.select, &run.axes))
+            .collect();
+        match spec.kind {
+            FigureKind::Convergence => figures.extend(convergence::figures(
+                experiment, &selected, spec, &mut names,
+            )),
+            FigureKind::Reconstruction => {
+                figures.extend(profiles::reconstructions(experiment, &selected, &mut names))
+            }
+            FigureKind::Basis => figures.extend(profiles::bases(experiment, &selected, &mut names)),
+        }
+    }
+    figures
+}
+
+/// File names already given out: two figures may land on the same stem, and later ones get
+/// a numeric suffix.
+#[derive(Default)]
+struct Names(BTreeSet<String>);
+
+impl Names {
+    /// `figures/<experiment>_<what>.png`, made unique.
+    fn file(&mut self, experiment: &Experiment, what: &str) -> PathBuf {
+        let stem = format!("{}_{}", slug(&experiment.name), slug(what));
+        let mut name = stem.clone();
+        let mut k = 2;
+        while !self.0.insert(name.clone()) {
+            name = format!("{stem}_{k}");
+            k += 1;
+        }
+        PathBuf::from("figures").join(name + ".png")
+    }
+}

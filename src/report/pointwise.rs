@@ -1,0 +1,143 @@
+//! The tables of pointwise values that reconstruction experiments ask for: u - u^h at the
+//! nodes in Gong's format (Tables 4.1-4.2) and the <p_i, p_i> of the orthogonal basis
+//! (Tran Figs 1-3). They go into report.md; the numbers come from the run files unchanged.
+
+use super::format::general;
+use super::group::{group_runs, label, selects};
+use crate::experiment::{Experiment, TableKind, TableSpec};
+use crate::output::{ReconstructionRecord, RunSummary};
+
+/// A table with a heading and a note on how to read it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    pub title: String,
+    pub note: String,
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+/// Every table the experiment's `tables` entries ask for, in their order.
+pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
+    let mut tables = Vec::new();
+    for spec in &experiment.tables {
+        let selected = runs.iter().filter(|run| selects(&spec.select, &run.axes));
+        match spec.kind {
+            TableKind::NodalErrors => tables.extend(nodal_errors(experiment, selected, spec)),
+            TableKind::BasisNorms => tables.extend(basis_norms(selected)),
+        }
+    }
+    tables
+}
+
+/// One table per group of the axes other than `columns`; a column per run of the group, in
+/// the order of the experiment's runs, a row per node, numbered from 1 as in the thesis.
+fn nodal_errors<'a>(
+    experiment: &Experiment,
+    runs: impl Iterator<Item = &'a RunSummary>,
+    spec: &TableSpec,
+) -> Vec<Table> {
+    let column_axis = spec.columns.as_deref().unwrap_or_default();
+    let order = |run: &RunSummary| experiment.runs.iter().position(|r| r.run_id == run.run_id);
+    group_runs(runs, &[column_axis])
+        .into_iter()
+        .filter_map(|group| {
+            let mut columns: Vec<(&RunSummary, &ReconstructionRecord)> = group
+                .runs
+                .iter()
+                .filter_map(|run| Some((*run, run.reconstruction.as_ref()?)))
+                .collect();
+            columns.sort_by_key(|(run, _)| order(run));
+            let nodes = columns.iter().map(|(_, r)| r.error.len()).max()?;
+            let mut header = vec!["i".to_string()];
+            header.extend(columns.iter().map(|(_, r)| format!("{} - u^h", r.formula)));
+            let rows =
+                (0..nodes)
+                    .map(|i| {
+                        let mut row = vec![(i + 1).to_string()];
+                        row.extend(columns.iter().map(|(_, r)| {
+                            r.error.get(i).map_or_else(String::new, |&e| decimals(e))
+                        }));
+                        row
+                    })
+                    .collect();
+            let within = if group.label.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", group.label)
+            };
+            Some(Table {
+                title: format!("u(x_i) - u^h(x_i) at the nodes{within}"),
+                note: "Four decimals as in Gong's Tables 4.1-4.2; an error below 1e-12 (rounding) \
+                       is printed as 0, a node without data in reach as NaN."
+                    .into(),
+                header,
+                rows,
+            })
+        })
+        .collect()
+}
+
+/// One row per run: the points, <p_i, p_i> of each polynomial and how many are kept.
+fn basis_norms<'a>(runs: impl Iterator<Item = &'a RunSummary>) -> Option<Table> {
+    let rows: Vec<(&RunSummary, &ReconstructionRecord)> = runs
+        .filter_map(|run| {
+            let record = run.reconstruction.as_ref()?;
+            record.basis.as_ref().map(|_| (run, record))
+        })
+        .collect();
+    let terms = rows
+        .iter()
+        .filter_map(|(_, r)| r.basis.as_ref().map(|b| b.terms))
+        .max()?;
+    let mut header = vec!["run".to_string(), "points x_p".to_string()];
+    header.extend((1..=terms).map(|i| format!("<p{i},p{i}>")));
+    header.push("kept".into());
+    let rows = rows
+        .into_iter()
+        .filter_map(|(run, r)| {
+            let basis = r.basis.as_ref()?;
+            let points: Vec<String> = r.data_x.iter().map(|&x| general(x, 4)).collect();
+            let mut row = vec![label(&run.axes), points.join(", ")];
+            row.extend(
+                (0..terms).map(|i| match (basis.norms.get(i), basis.kept.get(i)) {
+                    (Some(&norm), Some(0)) => format!("{} (dropped)", general(norm, 3)),
+                    (Some(&norm), _) => general(norm, 4),
+                    _ => String::new(),
+                }),
+            );
+            let kept = basis.kept.iter().filter(|&&k| k != 0).count();
+            row.push(format!("{kept} of {}", basis.terms));
+            Some(row)
+        })
+        .collect();
+    Some(Table {
+        title: "Weighted orthogonal polynomials (Tran eq 16)".into(),
+        note: "<p_i,p_i> = sum_p w(x_p - centre) p_i(x_p)^2; a polynomial is dropped (eq 17) when \
+               this is at most 1e-10 of the weighted norm of its monomial, i.e. zero up to rounding."
+            .into(),
+        header,
+        rows,
+    })
+}
+
+/// Four decimals; rounding-level values as 0.
+fn decimals(e: f64) -> String {
+    if e.abs() < 1e-12 {
+        "0".into()
+    } else {
+        format!("{e:.4}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn four_decimals_with_rounding_as_zero() {
+        assert_eq!(decimals(-0.068_749_9), "-0.0687");
+        assert_eq!(decimals(0.130_625), "0.1306");
+        assert_eq!(decimals(3e-17), "0");
+        assert_eq!(decimals(f64::NAN), "NaN");
+    }
+}

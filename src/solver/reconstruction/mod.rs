@@ -1,0 +1,143 @@
+//! One run of a reconstruction benchmark: place the data, fit the method's local least
+//! squares at the grid nodes, and record u - u^h there; for `recon1d_basis` also the weighted
+//! orthogonal basis. No time stepping.
+
+mod basis;
+
+use nalgebra::SVector;
+
+use super::base_record;
+use crate::benchmarks::scattered::ScatteredData;
+use crate::experiment::RunSpec;
+use crate::output::{ReconstructionRecord, RunRecord, RunStatus};
+use crate::reconstruct::{Kernel, Lattice, Recipe, Reconstructor};
+use crate::reconstruction_methods::{self, ReconstructionMethod};
+use crate::shape::Grid;
+
+/// Samples of u on the interval for plots: smooth enough for sin(pi x) at any scale.
+const CURVE_SAMPLES: usize = 401;
+
+/// Runs one configuration. A run whose method cannot be fitted (a singular MLS moment matrix)
+/// is `failed`, with the evaluation point in `message` and the data still recorded.
+pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
+    let mut record = base_record(spec, String::new());
+    let (data, method) = match prepare(spec) {
+        Ok(prepared) => prepared,
+        Err(message) => {
+            record.message = message;
+            record.reconstruction = Some(ReconstructionRecord {
+                l2: f64::NAN,
+                max: f64::NAN,
+                ..Default::default()
+            });
+            return record;
+        }
+    };
+    let grid = Grid::new(&data.domain);
+    record.h = grid.h;
+    let mut out = describe(&data, method);
+    match fit_nodes(&data, method, &grid, &mut out) {
+        Ok(()) => record.status = RunStatus::Ok,
+        Err(message) => record.message = message,
+    }
+    out.basis = data
+        .basis_centre
+        .map(|centre| basis::record(&data, method.degree, grid.h, centre, &out.curve_x));
+    record.reconstruction = Some(out);
+    record
+}
+
+fn prepare(spec: &RunSpec) -> Result<(ScatteredData, &'static ReconstructionMethod), String> {
+    let method = reconstruction_methods::method(&spec.method).ok_or_else(|| {
+        format!(
+            "unknown reconstruction method '{}'; valid: {}",
+            spec.method,
+            reconstruction_methods::method_names().join(", ")
+        )
+    })?;
+    let data =
+        ScatteredData::from_params(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
+    Ok((data, method))
+}
+
+/// The record before the fit: the method, the data and the exact values; the fit's outputs
+/// are NaN until `fit_nodes` fills them.
+fn describe(data: &ScatteredData, method: &ReconstructionMethod) -> ReconstructionRecord {
+    let u = |xs: &[f64]| {
+        xs.iter()
+            .map(|&x| data.function.eval(x))
+            .collect::<Vec<f64>>()
+    };
+    let (lower, upper) = (data.domain.lower[0], data.domain.upper[0]);
+    let nodes = data.domain.cells + 1;
+    let x: Vec<f64> = (0..nodes)
+        .map(|i| lower + (upper - lower) * i as f64 / data.domain.cells as f64)
+        .collect();
+    let curve_x: Vec<f64> = (0..CURVE_SAMPLES)
+        .map(|k| lower + (upper - lower) * k as f64 / (CURVE_SAMPLES - 1) as f64)
+        .collect();
+    ReconstructionRecord {
+        formula: data.function.formula().to_string(),
+        weight: data.weight.name().to_string(),
+        scale: data.scale,
+        degree: method.degree.value() as i64,
+        solver: method.solver.to_string(),
+        exact: u(&x),
+        reconstructed: vec![f64::NAN; nodes],
+        error: vec![f64::NAN; nodes],
+        x,
+        data_u: u(&data.points),
+        data_x: data.points.clone(),
+        curve_u: u(&curve_x),
+        curve_x,
+        l2: f64::NAN,
+        max: f64::NAN,
+        fits: 0,
+        rank_deficient: 0,
+        uncovered: 0,
+        basis: None,
+    }
+}
+
+/// u^h at the nodes, u - u^h and its norms. Nodes without data in reach keep NaN, and so
+/// do the norms: nothing is left out silently.
+fn fit_nodes(
+    data: &ScatteredData,
+    method: &ReconstructionMethod,
+    grid: &Grid<1>,
+    out: &mut ReconstructionRecord,
+) -> Result<(), String> {
+    let recipe = Recipe {
+        kernel: Kernel {
+            weight: data.weight,
+            scale: data.scale,
+        },
+        degree: method.degree,
+        solver: method.solver,
+    };
+    let mut reconstructor = Reconstructor::new(recipe, Lattice::nodes(grid));
+    let positions: Vec<SVector<f64, 1>> = data.points.iter().map(|&x| [x].into()).collect();
+    let stats = reconstructor.fit(&positions).map_err(|e| e.to_string())?;
+    reconstructor.apply(&out.data_u, &mut out.reconstructed);
+    for e in 0..out.x.len() {
+        if !reconstructor.covered(e) {
+            out.reconstructed[e] = f64::NAN;
+            out.uncovered += 1;
+        }
+        out.error[e] = out.exact[e] - out.reconstructed[e];
+    }
+    out.fits = stats.fits as i64;
+    out.rank_deficient = stats.rank_deficient as i64;
+    out.l2 = out.error.iter().map(|e| grid.h * e * e).sum::<f64>().sqrt();
+    out.max = out.error.iter().map(|e| e.abs()).fold(0.0, nan_max);
+    Ok(())
+}
+
+/// The larger of two numbers, NaN if either is (`f64::max` would drop the NaN).
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
