@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use crate::shape::Grid;
+use crate::shape::{axis_strides, Grid};
 
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
@@ -20,10 +20,7 @@ pub struct Lattice<const D: usize> {
 
 impl<const D: usize> Lattice<D> {
     fn new(grid: &Grid<D>, offsets: Vec<f64>, per_axis: usize) -> Self {
-        let mut strides = [1; D];
-        for k in 1..D {
-            strides[k] = strides[k - 1] * per_axis;
-        }
+        let strides = axis_strides(per_axis);
         Lattice {
             lower: grid.lower,
             h: grid.h,

@@ -12,7 +12,7 @@ use num_traits::Zero;
 use super::basis::{monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
-use super::solve::{mls_coefficients, Moments, OrthogonalBasis};
+use super::solve::{add_weighted_outer, mls_coefficients, Moments, OrthogonalBasis};
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,13 +57,10 @@ impl AddAssign for FitStats {
 
 impl fmt::Display for Recipe {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let solver = match self.solver {
-            Solver::Mls => "mls",
-            Solver::Imls => "imls",
-        };
         write!(
             f,
-            "{solver}[{}, degree {}]",
+            "{}[{}, degree {}]",
+            self.solver,
             self.kernel,
             self.degree.value()
         )
@@ -92,8 +89,8 @@ impl fmt::Display for SingularMoments {
 const MAX_PER_AXIS: usize = 32;
 
 /// The widest support radius, in cells, that `Reconstructor::new` accepts on a lattice of
-/// grid nodes: an open interval of 2 x 15 cells meets at most 31 nodes per axis.
-pub const MAX_NODE_SUPPORT_CELLS: f64 = 15.0;
+/// grid nodes: an open interval of 2 r cells meets at most 2 r + 1 nodes per axis.
+pub const MAX_NODE_SUPPORT_CELLS: f64 = ((MAX_PER_AXIS - 2) / 2) as f64;
 
 pub struct Reconstructor<const D: usize> {
     recipe: Recipe,
@@ -210,12 +207,7 @@ impl<const D: usize> Reconstructor<D> {
                 self.offset[entry] = d;
                 self.phi[entry] = w;
                 monomials(self.recipe.degree, &d, &mut q);
-                let a = &mut self.moments[e * t * t..(e + 1) * t * t];
-                for r in 0..t {
-                    for s in 0..t {
-                        a[r * t + s] += w * q[r] * q[s];
-                    }
-                }
+                add_weighted_outer(&mut self.moments[e * t * t..(e + 1) * t * t], t, w, &q[..t]);
             }
         }
     }

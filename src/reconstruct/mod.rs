@@ -20,7 +20,7 @@ pub use least_squares::{
     FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,
 };
 pub use quadrature::{QuadratureRecipe, QuadratureTransfer};
-pub use shepard::particles_to_grid;
+pub use shepard::{particles_to_grid, remap_velocity};
 pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
 
 /// Nodal quantities assembled from the particles each step.

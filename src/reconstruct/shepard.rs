@@ -28,8 +28,35 @@ pub fn particles_to_grid<const D: usize>(
             grid.force[i] += mb * w - vs * g;
         }
     }
-    for (v, &m) in grid.velocity.iter_mut().zip(&grid.mass) {
-        *v = if m > grid.empty_mass {
+    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
+}
+
+/// MUSL's v_i^L for the Shepard mapping: sum_p M_p v_p N_ip / m_i with this step's weights
+/// and nodal masses.
+pub fn remap_velocity<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    grid: &GridState<D>,
+    out: &mut [SVector<f64, D>],
+) {
+    out.fill(SVector::zeros());
+    for p in 0..particles.len() {
+        let mv = particles.v[p] * particles.mass[p];
+        for (i, w, _) in stencils.of(p) {
+            out[i] += mv * w;
+        }
+    }
+    momentum_to_velocity(out, &grid.mass, grid.empty_mass);
+}
+
+/// Divides nodal momenta by the nodal masses; empty nodes are left at rest.
+fn momentum_to_velocity<const D: usize>(
+    velocity: &mut [SVector<f64, D>],
+    mass: &[f64],
+    empty_mass: f64,
+) {
+    for (v, &m) in velocity.iter_mut().zip(mass) {
+        *v = if m > empty_mass {
             *v / m
         } else {
             SVector::zeros()

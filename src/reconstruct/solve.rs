@@ -31,15 +31,21 @@ pub fn moment_matrix<const D: usize>(
     let mut q = [0.0; MAX_TERMS];
     let terms = degree.terms(D);
     for d in offsets {
-        let w = kernel.eval(d);
         monomials(degree, d, &mut q);
-        for r in 0..terms {
-            for s in 0..terms {
-                a[r * MAX_TERMS + s] += w * q[r] * q[s];
-            }
-        }
+        add_weighted_outer(&mut a, MAX_TERMS, kernel.eval(d), &q[..terms]);
     }
     (a, terms)
+}
+
+/// a += w q q^T for a row-major matrix with row length `stride`.
+#[inline]
+pub(super) fn add_weighted_outer(a: &mut [f64], stride: usize, w: f64, q: &[f64]) {
+    for (r, &qr) in q.iter().enumerate() {
+        let wq = w * qr;
+        for (s, &qs) in q.iter().enumerate() {
+            a[r * stride + s] += wq * qs;
+        }
+    }
 }
 
 /// The weighted orthogonal polynomials p_i = sum_j coeffs[i][j] q_j of Tran eq 16, built

@@ -137,20 +137,14 @@ fn imls_equals_mls_when_well_conditioned() {
     check_imls_equals_mls::<2>(Degree::QUADRATIC);
 }
 
-/// Moments of `points` about the origin with unit weights, as the orthogonalisation sees them.
+/// Moments of `points` about the origin with a hat weight wide enough to reach all of them
+/// (rank does not depend on the positive weights).
 fn moments<const D: usize>(points: &[SVector<f64, D>], degree: Degree) -> (Moments, usize) {
-    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
-    let mut q = [0.0; MAX_TERMS];
-    let mut terms = 0;
-    for p in points {
-        terms = monomials(degree, p, &mut q);
-        for r in 0..terms {
-            for s in 0..terms {
-                a[r * MAX_TERMS + s] += q[r] * q[s];
-            }
-        }
-    }
-    (a, terms)
+    let wide = Kernel {
+        weight: Weight::Hat,
+        scale: 10.0,
+    };
+    moment_matrix(&wide, degree, points)
 }
 
 /// Tran eq 17: with r independent data the basis keeps r polynomials. 1, 2 and 3 points

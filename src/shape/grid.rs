@@ -19,10 +19,7 @@ impl<const D: usize> Grid<D> {
     pub fn new(domain: &Domain<D>) -> Self {
         let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
         let n = domain.cells + 1;
-        let mut strides = [1; D];
-        for k in 1..D {
-            strides[k] = strides[k - 1] * n;
-        }
+        let strides = axis_strides(n);
         Grid {
             lower: domain.lower,
             h,
@@ -81,4 +78,14 @@ impl<const D: usize> Grid<D> {
     pub fn stride(&self, axis: usize) -> usize {
         self.strides[axis]
     }
+}
+
+/// Flat-index strides of a `D`-dimensional lattice with `per_axis` points along each axis,
+/// the first axis fastest.
+pub fn axis_strides<const D: usize>(per_axis: usize) -> [usize; D] {
+    let mut strides = [1; D];
+    for k in 1..D {
+        strides[k] = strides[k - 1] * per_axis;
+    }
+    strides
 }

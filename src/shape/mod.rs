@@ -6,7 +6,7 @@ mod stencils;
 
 use nalgebra::SVector;
 
-pub use grid::Grid;
+pub use grid::{axis_strides, Grid};
 pub use linear::LinearHat;
 pub use stencils::Stencils;
 

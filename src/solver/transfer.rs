@@ -5,7 +5,9 @@ use nalgebra::SVector;
 use crate::integrate::Divergence;
 use crate::methods::TransferKind;
 use crate::particles::Particles;
-use crate::reconstruct::{particles_to_grid, FitStats, GridState, QuadratureTransfer};
+use crate::reconstruct::{
+    particles_to_grid, remap_velocity, FitStats, GridState, QuadratureTransfer,
+};
 use crate::shape::{Grid, Shape, Stencils};
 
 pub enum Transfer<const D: usize> {
@@ -52,22 +54,7 @@ impl<const D: usize> Transfer<D> {
         out: &mut [SVector<f64, D>],
     ) {
         match self {
-            Transfer::Shepard => {
-                out.fill(SVector::zeros());
-                for p in 0..particles.len() {
-                    let mv = particles.v[p] * particles.mass[p];
-                    for (i, w, _) in stencils.of(p) {
-                        out[i] += mv * w;
-                    }
-                }
-                for (v, &m) in out.iter_mut().zip(&grid.mass) {
-                    *v = if m > grid.empty_mass {
-                        *v / m
-                    } else {
-                        SVector::zeros()
-                    };
-                }
-            }
+            Transfer::Shepard => remap_velocity(stencils, particles, grid, out),
             Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
         }
     }
