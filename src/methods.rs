@@ -4,12 +4,15 @@
 use std::fmt;
 
 use crate::reconstruct::{Degree, Kernel, QuadratureRecipe, Recipe, Solver, Weight};
+use crate::shape::DomainShape;
 
 /// Basis functions used on the background grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShapeKind {
     /// Piecewise-linear hat (tensor product in 2D), Gong eq 4.8.
     Linear,
+    /// The hat averaged over each particle's domain (GIMP, CPDI; Gong ch. 6).
+    Domain(DomainShape),
 }
 
 /// How particle data reaches the grid.
@@ -19,6 +22,9 @@ pub enum TransferKind {
     Shepard,
     /// Least-squares fits evaluated at nodes and quadrature points (IMPM, IMLS-MPM).
     Quadrature(QuadratureRecipe),
+    /// Mass and forces lumped as in `Shepard`, the nodal velocity a least-squares fit of the
+    /// particle velocities (improved CPDI, Gong sec 6.6).
+    FittedVelocity(Recipe),
 }
 
 /// How the grid equations are advanced in time.
@@ -76,6 +82,18 @@ const IMLS_EQ27: QuadratureRecipe = QuadratureRecipe {
     ..IMLS
 };
 
+const fn on_domains(
+    shape: DomainShape,
+    transfer: TransferKind,
+    integrator: IntegratorKind,
+) -> Method {
+    Method {
+        shape: ShapeKind::Domain(shape),
+        transfer,
+        integrator,
+    }
+}
+
 const PRESETS: &[MethodPreset] = &[
     MethodPreset {
         name: "mpm",
@@ -127,6 +145,66 @@ const PRESETS: &[MethodPreset] = &[
         source: "Tran, Berzins, Solowski 2019, eq 27 as printed",
         description: "IMLS-MPM with the field weight scaled by 2h (support 3h)",
     },
+    MethodPreset {
+        name: "ugimp",
+        method: on_domains(
+            DomainShape::FixedBox,
+            TransferKind::Shepard,
+            IntegratorKind::Leapfrog,
+        ),
+        source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
+        description: "uGIMP: the hat averaged over the initial particle box, leapfrog",
+    },
+    MethodPreset {
+        name: "cpgimp",
+        method: on_domains(
+            DomainShape::StretchedBox,
+            TransferKind::Shepard,
+            IntegratorKind::Leapfrog,
+        ),
+        source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
+        description: "cpGIMP: the particle box stretched by the diagonal of F, leapfrog",
+    },
+    MethodPreset {
+        name: "cpdi1",
+        method: on_domains(
+            DomainShape::Parallelogram,
+            TransferKind::Shepard,
+            IntegratorKind::Leapfrog,
+        ),
+        source: "Sadeghirad et al. 2011; Gong 2015, sec 6.4",
+        description: "CPDI1: parallelogram domains r_k = F r_k^0, leapfrog",
+    },
+    MethodPreset {
+        name: "cpdi1_musl",
+        method: on_domains(
+            DomainShape::Parallelogram,
+            TransferKind::Shepard,
+            IntegratorKind::Musl,
+        ),
+        source: "Sadeghirad et al. 2011 in the scheme of Tran et al. 2019, eqs 31-40",
+        description: "CPDI1 with the modified update-stress-last step",
+    },
+    MethodPreset {
+        name: "cpdi2",
+        method: on_domains(
+            DomainShape::Quadrilateral,
+            TransferKind::Shepard,
+            IntegratorKind::Leapfrog,
+        ),
+        source: "Sadeghirad et al. 2013; Gong 2015, secs 6.5-6.6",
+        description: "CPDI2: domain corners moved with the grid velocity, leapfrog",
+    },
+    MethodPreset {
+        name: "cpdi_mls",
+        method: on_domains(
+            DomainShape::Quadrilateral,
+            TransferKind::FittedVelocity(IMPM.velocity),
+            IntegratorKind::Leapfrog,
+        ),
+        source: "Gong 2015, sec 6.6 (improved CPDI)",
+        description: "CPDI2 with IMPM's MLS velocity at the nodes (cubic spline), leapfrog",
+    },
 ];
 
 pub fn presets() -> &'static [MethodPreset] {
@@ -143,9 +221,10 @@ pub fn preset_names() -> Vec<&'static str> {
 
 impl fmt::Display for ShapeKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            ShapeKind::Linear => "linear",
-        })
+        match self {
+            ShapeKind::Linear => f.write_str("linear"),
+            ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
+        }
     }
 }
 
@@ -154,6 +233,7 @@ impl fmt::Display for TransferKind {
         match self {
             TransferKind::Shepard => f.write_str("shepard"),
             TransferKind::Quadrature(recipe) => write!(f, "quadrature({recipe})"),
+            TransferKind::FittedVelocity(recipe) => write!(f, "fitted-velocity({recipe})"),
         }
     }
 }

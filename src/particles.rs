@@ -19,6 +19,31 @@ pub struct Particles<const D: usize> {
     pub stress: Vec<SMatrix<f64, D, D>>,
     pub mass: Vec<f64>,
     pub volume0: Vec<f64>,
+    /// Current volume: J V^0, or the area of the tracked domain for CPDI2.
+    pub volume: Vec<f64>,
+    /// Where the points were seeded.
+    pub lattice: SeedLattice<D>,
+}
+
+/// The regular sub-grid the particles were seeded on: particle p sits at the centre of
+/// sub-cell `m` (first axis fastest), whose corners are lower + (m + {0,1}) spacing.
+#[derive(Clone, Copy, Debug)]
+pub struct SeedLattice<const D: usize> {
+    pub lower: SVector<f64, D>,
+    pub spacing: f64,
+    pub per_axis: [usize; D],
+}
+
+impl<const D: usize> SeedLattice<D> {
+    /// Sub-cell coordinates of particle `p`.
+    pub fn cell_of(&self, p: usize) -> [usize; D] {
+        let mut rest = p;
+        std::array::from_fn(|k| {
+            let m = rest % self.per_axis[k];
+            rest /= self.per_axis[k];
+            m
+        })
+    }
 }
 
 impl<const D: usize> Particles<D> {
@@ -32,16 +57,17 @@ impl<const D: usize> Particles<D> {
             std::array::from_fn(|k| ((hi[k] - lo[k]) / grid.h).round() as usize * ppc);
         let count: usize = per_axis.iter().product();
         let volume = spacing.powi(D as i32);
-        let mut x0 = Vec::with_capacity(count);
-        for index in 0..count {
-            let mut rest = index;
-            let x = SVector::<f64, D>::from_fn(|k, _| {
-                let m = rest % per_axis[k];
-                rest /= per_axis[k];
-                lo[k] + (m as f64 + 0.5) * spacing
-            });
-            x0.push(x);
-        }
+        let lattice = SeedLattice {
+            lower: lo,
+            spacing,
+            per_axis,
+        };
+        let x0: Vec<SVector<f64, D>> = (0..count)
+            .map(|p| {
+                let m = lattice.cell_of(p);
+                SVector::from_fn(|k, _| lo[k] + (m[k] as f64 + 0.5) * spacing)
+            })
+            .collect();
         let v = x0.iter().map(|x| problem.initial_velocity(x)).collect();
         Particles {
             x: x0.clone(),
@@ -51,6 +77,8 @@ impl<const D: usize> Particles<D> {
             stress: vec![SMatrix::zeros(); count],
             mass: vec![problem.rho0() * volume; count],
             volume0: vec![volume; count],
+            volume: vec![volume; count],
+            lattice,
             x0,
         }
     }
@@ -63,9 +91,8 @@ impl<const D: usize> Particles<D> {
         self.x.is_empty()
     }
 
-    /// Current volume V_p = J_p V_p^0.
     #[inline]
     pub fn volume(&self, p: usize) -> f64 {
-        self.j[p] * self.volume0[p]
+        self.volume[p]
     }
 }

@@ -6,7 +6,7 @@ use super::Divergence;
 use crate::material::{det, NeoHookean};
 use crate::particles::Particles;
 
-/// F_p = (I + dt grad v_p) F_p, J_p = det F_p and the stress, after checking that the
+/// F_p = (I + dt grad v_p) F_p, J_p = det F_p, V_p = J_p V_p^0 and the stress, after checking that the
 /// new state is finite and not inverted. `accel_finite` reports the acceleration gathered in
 /// the same pass, so that a non-finite grid is caught at the first particle that sees it.
 // Always inlined: it sits in the innermost particle loops, and a call there costs a fifth
@@ -33,6 +33,7 @@ pub(super) fn deform_particle<const D: usize>(
     }
     particles.f[p] = f;
     particles.j[p] = j;
+    particles.volume[p] = j * particles.volume0[p];
     particles.stress[p] = material.cauchy(&f, j);
     Ok(())
 }

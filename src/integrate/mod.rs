@@ -9,6 +9,7 @@ use std::fmt;
 use nalgebra::SVector;
 
 use crate::reconstruct::GridState;
+use crate::shape::DomainFault;
 
 /// Why a run stopped early. Recorded in the run file's `message` with the step.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +27,17 @@ pub enum Divergence {
     },
     /// A reconstruction could not be solved (MLS with a singular moment matrix).
     Reconstruction(String),
+    /// A particle domain could not be mapped (GIMP, CPDI).
+    Domain(DomainFault),
+}
+
+impl From<DomainFault> for Divergence {
+    fn from(fault: DomainFault) -> Self {
+        match fault {
+            DomainFault::Outside(particle) => Divergence::LeftGrid { particle },
+            fault => Divergence::Domain(fault),
+        }
+    }
 }
 
 impl fmt::Display for Divergence {
@@ -39,6 +51,7 @@ impl fmt::Display for Divergence {
                 write!(f, "particle {particle} has a non-finite {what}")
             }
             Divergence::Reconstruction(reason) => f.write_str(reason),
+            Divergence::Domain(fault) => write!(f, "{fault}"),
         }
     }
 }

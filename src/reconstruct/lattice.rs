@@ -121,7 +121,7 @@ impl<const D: usize> Lattice<D> {
 }
 
 /// Gauss-Legendre abscissae and weights on [-1, 1].
-fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
+pub(crate) fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
     const A2: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
     const A3: f64 = 0.774_596_669_241_483_4; // sqrt(3/5)
     match n {

@@ -15,6 +15,8 @@ use nalgebra::SVector;
 
 pub use basis::{monomials, Degree, MAX_TERMS};
 pub use kernel::{Kernel, Weight};
+#[cfg(test)]
+pub(crate) use lattice::gauss_legendre;
 pub use lattice::Lattice;
 pub use least_squares::{
     FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,

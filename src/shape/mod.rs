@@ -1,11 +1,13 @@
 //! Basis functions on the background grid and the per-particle tables of their values.
 
+mod domain;
 mod grid;
 mod linear;
 mod stencils;
 
 use nalgebra::SVector;
 
+pub use domain::{DomainFault, DomainShape, ParticleDomains};
 pub use grid::{axis_strides, Grid};
 pub use linear::LinearHat;
 pub use stencils::Stencils;

@@ -16,7 +16,7 @@ use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
 use crate::reconstruct::{FitStats, GridState};
-use crate::shape::{Grid, LinearHat, Shape, Stencils};
+use crate::shape::{Grid, LinearHat, ParticleDomains, Shape, Stencils};
 
 use recorder::Recorder;
 use transfer::Transfer;
@@ -62,17 +62,23 @@ fn run_with_method<const D: usize>(
     method: Method,
     problem: Box<dyn Problem<D>>,
 ) -> RunRecord {
-    match method.shape {
-        ShapeKind::Linear => Run::new(spec, method, problem, LinearHat).execute(),
-    }
+    Run::new(spec, method, problem).execute()
+}
+
+/// The grid basis of a run as the particles see it.
+enum Basis<const D: usize> {
+    /// The hat evaluated at x_p.
+    Hat,
+    /// The hat averaged over each particle's domain.
+    Domains(ParticleDomains<D>),
 }
 
 /// The state of one run in progress.
-struct Run<'a, const D: usize, S: Shape<D>> {
+struct Run<'a, const D: usize> {
     spec: &'a RunSpec,
     method: Method,
     problem: Box<dyn Problem<D>>,
-    shape: S,
+    basis: Basis<D>,
     grid: Grid<D>,
     particles: Particles<D>,
     stencils: Stencils<D>,
@@ -86,20 +92,28 @@ struct Run<'a, const D: usize, S: Shape<D>> {
     recorder: Recorder,
 }
 
-impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
-    fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>, shape: S) -> Self {
+impl<'a, const D: usize> Run<'a, D> {
+    fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>) -> Self {
         let grid = Grid::new(&problem.domain());
         let particles = Particles::seed(problem.as_ref(), &grid);
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
+        let (basis, per_point) = match method.shape {
+            ShapeKind::Linear => (Basis::Hat, Shape::<D>::nodes_per_point(&LinearHat)),
+            ShapeKind::Domain(shape) => (
+                Basis::Domains(ParticleDomains::new(shape, &particles)),
+                ParticleDomains::<D>::nodes_per_point(),
+            ),
+        };
         Run {
             spec,
             method,
-            stencils: Stencils::new(shape.nodes_per_point(), n),
-            transfer: Transfer::new(&method.transfer, &grid, &shape),
-            shape,
+            stencils: Stencils::new(per_point, n),
+            // Quadrature points see the grid's own hat whatever the particles use.
+            transfer: Transfer::new(&method.transfer, &grid, &LinearHat),
+            basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
             grid,
@@ -134,11 +148,8 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
         let steps = self.problem.steps();
         let every = self.spec.output_every;
         let mut synced = vec![SVector::zeros(); self.particles.len()];
-        if let Err(p) = self
-            .stencils
-            .update(&self.shape, &self.grid, &self.particles.x)
-        {
-            return (0, Err((0, Divergence::LeftGrid { particle: p })));
+        if let Err(reason) = self.update_stencils() {
+            return (0, Err((0, reason)));
         }
         for s in 0..=steps {
             let t = s as f64 * dt;
@@ -184,22 +195,36 @@ impl<'a, const D: usize, S: Shape<D>> Run<'a, D, S> {
             if s == steps {
                 break;
             }
-            if let Err(reason) = self.update_particles(kick, dt) {
-                return (s, Err((s + 1, reason)));
-            }
-            if let Err(p) = self
-                .stencils
-                .update(&self.shape, &self.grid, &self.particles.x)
+            if let Err(reason) = self
+                .update_particles(kick, dt)
+                .and_then(|()| self.update_stencils())
             {
-                return (s, Err((s + 1, Divergence::LeftGrid { particle: p })));
+                return (s, Err((s + 1, reason)));
             }
         }
         (steps, Ok(()))
     }
 
+    /// The shape functions of every particle at its current position and domain.
+    fn update_stencils(&mut self) -> Result<(), Divergence> {
+        match &self.basis {
+            Basis::Hat => self
+                .stencils
+                .update(&LinearHat, &self.grid, &self.particles.x)
+                .map_err(|particle| Divergence::LeftGrid { particle }),
+            Basis::Domains(domains) => {
+                domains.fill(&self.grid, &mut self.particles, &mut self.stencils)?;
+                Ok(())
+            }
+        }
+    }
+
     /// Step 3 of the method's integrator, after the grid solve.
     fn update_particles(&mut self, kick: f64, dt: f64) -> Result<(), Divergence> {
         let material = self.problem.material();
+        if let Basis::Domains(domains) = &mut self.basis {
+            domains.advance_corners(&self.grid, &self.nodes.velocity_new, dt)?;
+        }
         match self.method.integrator {
             IntegratorKind::Leapfrog => leapfrog::update_particles(
                 &self.stencils,

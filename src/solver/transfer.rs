@@ -6,13 +6,16 @@ use crate::integrate::Divergence;
 use crate::methods::TransferKind;
 use crate::particles::Particles;
 use crate::reconstruct::{
-    particles_to_grid, remap_velocity, FitStats, GridState, QuadratureTransfer,
+    particles_to_grid, remap_velocity, FitStats, GridState, Lattice, QuadratureTransfer,
+    Reconstructor,
 };
 use crate::shape::{Grid, Shape, Stencils};
 
 pub enum Transfer<const D: usize> {
     Shepard,
     Quadrature(Box<QuadratureTransfer<D>>),
+    /// The Shepard transfer with the nodal velocity replaced by this fit at the nodes.
+    FittedVelocity(Box<Reconstructor<D>>),
 }
 
 impl<const D: usize> Transfer<D> {
@@ -22,6 +25,9 @@ impl<const D: usize> Transfer<D> {
             TransferKind::Quadrature(recipe) => {
                 Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid, shape)))
             }
+            TransferKind::FittedVelocity(recipe) => Transfer::FittedVelocity(Box::new(
+                Reconstructor::new(*recipe, Lattice::nodes(grid)),
+            )),
         }
     }
 
@@ -41,6 +47,14 @@ impl<const D: usize> Transfer<D> {
             Transfer::Quadrature(q) => q
                 .map_to_grid(particles, body_force, grid)
                 .map_err(|e| Divergence::Reconstruction(e.to_string())),
+            Transfer::FittedVelocity(fit) => {
+                particles_to_grid(stencils, particles, body_force, grid);
+                let stats = fit
+                    .fit(&particles.x)
+                    .map_err(|e| Divergence::Reconstruction(e.to_string()))?;
+                fit.apply(&particles.v, &mut grid.velocity);
+                Ok(stats)
+            }
         }
     }
 
@@ -56,6 +70,7 @@ impl<const D: usize> Transfer<D> {
         match self {
             Transfer::Shepard => remap_velocity(stencils, particles, grid, out),
             Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
+            Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
         }
     }
 }

@@ -1,0 +1,355 @@
+//! Particle-domain shape functions (Gong ch. 6): each particle carries a domain Omega_p, and
+//! its effective basis is the grid hat averaged over that domain,
+//! S_ip = (1/V_p) int_{Omega_p} N_i and grad S_ip = (1/V_p) int_{Omega_p} grad N_i (eqs 6.4-6.5).
+//! GIMP averages the hat itself over an axis-aligned box; CPDI averages its interpolant from
+//! the domain's corners. The nodes a domain touches are the block of grid nodes around its
+//! bounding box, found from the box alone.
+
+mod cpdi;
+mod gimp;
+#[cfg(test)]
+mod tests;
+
+use std::fmt;
+
+use nalgebra::SVector;
+
+use super::{Grid, LinearHat, Shape, Stencils};
+use crate::particles::Particles;
+use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
+use gimp::{averaged_hats, hat};
+
+/// How a particle's domain is represented and follows the deformation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DomainShape {
+    /// uGIMP: the initial axis-aligned box around x_p, never deformed.
+    FixedBox,
+    /// cpGIMP: the box with each half-width stretched by the diagonal entry F_kk.
+    StretchedBox,
+    /// CPDI1: the parallelogram spanned by r_k = F r_k^0 around x_p (eq 6.21).
+    Parallelogram,
+    /// CPDI2: the quadrilateral whose corners move with the grid velocity (eq 6.28).
+    Quadrilateral,
+}
+
+impl DomainShape {
+    pub fn name(self) -> &'static str {
+        match self {
+            DomainShape::FixedBox => "ugimp",
+            DomainShape::StretchedBox => "cpgimp",
+            DomainShape::Parallelogram => "cpdi1",
+            DomainShape::Quadrilateral => "cpdi2",
+        }
+    }
+}
+
+impl fmt::Display for DomainShape {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Nodes per axis in a stencil: a domain may span up to three cells.
+pub const NODES_PER_AXIS: usize = 4;
+
+/// Why the stencils of a particle could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DomainFault {
+    /// The particle (or, for CPDI2, a corner of its domain) left the grid.
+    Outside(usize),
+    /// The domain spans more than `NODES_PER_AXIS - 1` cells along some axis.
+    TooWide(usize),
+    /// The domain has no positive volume (an inverted quadrilateral).
+    Inverted(usize),
+    /// A CPDI2 corner left the grid.
+    CornerOutside(usize),
+}
+
+impl fmt::Display for DomainFault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DomainFault::Outside(p) => write!(f, "particle {p} left the grid"),
+            DomainFault::TooWide(p) => write!(
+                f,
+                "the domain of particle {p} spans more than {} cells",
+                NODES_PER_AXIS - 1
+            ),
+            DomainFault::Inverted(p) => write!(f, "the domain of particle {p} is inverted"),
+            DomainFault::CornerOutside(c) => write!(f, "domain corner {c} left the grid"),
+        }
+    }
+}
+
+/// The domains of all particles and what is needed to evaluate their effective basis.
+pub struct ParticleDomains<const D: usize> {
+    shape: DomainShape,
+    /// Half-width of every initial domain: half the seed spacing.
+    half0: f64,
+    /// CPDI2: the corners of the seed lattice, shared by neighbouring domains.
+    corners: Vec<SVector<f64, D>>,
+    corner_strides: [usize; D],
+    /// CPDI2: for each particle, the index of its lowest corner.
+    first_corner: Vec<u32>,
+}
+
+impl<const D: usize> ParticleDomains<D> {
+    /// The initial domains: the seed sub-cells, which tile the body.
+    pub fn new(shape: DomainShape, particles: &Particles<D>) -> Self {
+        let lattice = &particles.lattice;
+        let mut domains = ParticleDomains {
+            shape,
+            half0: 0.5 * lattice.spacing,
+            corners: Vec::new(),
+            corner_strides: [0; D],
+            first_corner: Vec::new(),
+        };
+        if shape == DomainShape::Quadrilateral {
+            let points: [usize; D] = std::array::from_fn(|k| lattice.per_axis[k] + 1);
+            let mut stride = 1;
+            for k in 0..D {
+                domains.corner_strides[k] = stride;
+                stride *= points[k];
+            }
+            domains.corners = (0..stride)
+                .map(|c| {
+                    SVector::from_fn(|k, _| {
+                        let m = c / domains.corner_strides[k] % points[k];
+                        lattice.lower[k] + m as f64 * lattice.spacing
+                    })
+                })
+                .collect();
+            domains.first_corner = (0..particles.len())
+                .map(|p| {
+                    let m = lattice.cell_of(p);
+                    (0..D)
+                        .map(|k| m[k] * domains.corner_strides[k])
+                        .sum::<usize>() as u32
+                })
+                .collect();
+        }
+        domains
+    }
+
+    pub fn nodes_per_point() -> usize {
+        NODES_PER_AXIS.pow(D as u32)
+    }
+
+    /// Fills every particle's stencil with S_ip and grad S_ip. CPDI2 also sets each
+    /// particle's volume to the area of its quadrilateral.
+    pub fn fill(
+        &self,
+        grid: &Grid<D>,
+        particles: &mut Particles<D>,
+        stencils: &mut Stencils<D>,
+    ) -> Result<(), DomainFault> {
+        let mut corners = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        for p in 0..particles.len() {
+            let range = p * stencils.per_point..(p + 1) * stencils.per_point;
+            let node = &mut stencils.node[range.clone()];
+            let weight = &mut stencils.weight[range.clone()];
+            let grad = &mut stencils.grad[range];
+            let x = particles.x[p];
+            if grid.locate(&x).is_none() {
+                return Err(DomainFault::Outside(p));
+            }
+            match self.shape {
+                DomainShape::FixedBox | DomainShape::StretchedBox => {
+                    let half = SVector::<f64, D>::from_fn(|k, _| match self.shape {
+                        DomainShape::StretchedBox => self.half0 * particles.f[p][(k, k)],
+                        _ => self.half0,
+                    });
+                    fill_box(grid, &x, &half, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
+                }
+                DomainShape::Parallelogram | DomainShape::Quadrilateral => {
+                    for (a, corner) in corners.iter_mut().take(1 << D).enumerate() {
+                        *corner = if self.shape == DomainShape::Parallelogram {
+                            x + particles.f[p] * reference_corner::<D>(a) * self.half0
+                        } else {
+                            self.corners[self.corner_of(p, a)]
+                        };
+                        *corner = clamp_to_grid(grid, corner);
+                    }
+                    let cw = corner_weights(&corners[..1 << D]).ok_or(DomainFault::Inverted(p))?;
+                    fill_corners(grid, &corners[..1 << D], &cw, node, weight, grad)
+                        .ok_or(DomainFault::TooWide(p))?;
+                    if self.shape == DomainShape::Quadrilateral {
+                        particles.volume[p] = cw.volume;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// CPDI2 (eq 6.28): every corner moves with the grid velocity interpolated by the hat,
+    /// x_a += dt sum_i N_i(x_a) v_i. Other shapes keep no corners.
+    pub fn advance_corners(
+        &mut self,
+        grid: &Grid<D>,
+        velocity: &[SVector<f64, D>],
+        dt: f64,
+    ) -> Result<(), DomainFault> {
+        let per_point = Shape::<D>::nodes_per_point(&LinearHat);
+        let mut node = [0u32; MAX_CORNERS];
+        let mut weight = [0.0; MAX_CORNERS];
+        let mut grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        for (c, corner) in self.corners.iter_mut().enumerate() {
+            let (node, weight) = (&mut node[..per_point], &mut weight[..per_point]);
+            if !LinearHat.eval(grid, corner, node, weight, &mut grad[..per_point]) {
+                return Err(DomainFault::CornerOutside(c));
+            }
+            let v: SVector<f64, D> = node
+                .iter()
+                .zip(weight.iter())
+                .map(|(&i, &n)| velocity[i as usize] * n)
+                .sum();
+            *corner += v * dt;
+        }
+        Ok(())
+    }
+
+    /// Index of corner `a` (in the order of `reference_corner`) of particle `p`'s domain.
+    fn corner_of(&self, p: usize, a: usize) -> usize {
+        let r = reference_corner::<D>(a);
+        let offset: usize = (0..D)
+            .map(|k| {
+                if r[k] > 0.0 {
+                    self.corner_strides[k]
+                } else {
+                    0
+                }
+            })
+            .sum();
+        self.first_corner[p] as usize + offset
+    }
+}
+
+/// A point moved onto the grid along each axis. The benchmarks' bodies fill the grid, so a
+/// domain reaches past it only by the small mismatch between the convected domain and the
+/// material (CPDI1 corners x_p +- F r^0 at a fixed face); the part outside is folded onto the
+/// face, which keeps the partition of unity.
+fn clamp_to_grid<const D: usize>(grid: &Grid<D>, x: &SVector<f64, D>) -> SVector<f64, D> {
+    let upper = grid.cells as f64 * grid.h;
+    SVector::from_fn(|k, _| x[k].clamp(grid.lower[k], grid.lower[k] + upper))
+}
+
+/// The first node of the stencil block along each axis for a bounding box [lo, hi] (in cell
+/// units from the grid's lower corner), or `None` when the box spans more cells than a block.
+fn block_start<const D: usize>(
+    grid: &Grid<D>,
+    lo: &SVector<f64, D>,
+    hi: &SVector<f64, D>,
+) -> Option<[usize; D]> {
+    let last_start = grid.cells.saturating_sub(NODES_PER_AXIS - 1);
+    let mut start = [0; D];
+    for k in 0..D {
+        start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
+        if hi[k] > (start[k] + NODES_PER_AXIS - 1) as f64 {
+            return None;
+        }
+    }
+    Some(start)
+}
+
+/// Node index of entry `e` of a stencil block starting at `start`: the block's first axis
+/// runs fastest. Entries past the grid (grids with fewer than three cells) repeat the last node
+/// with zero weight.
+fn block_node<const D: usize>(grid: &Grid<D>, start: &[usize; D], e: usize) -> (usize, [usize; D]) {
+    let mut index = 0;
+    let mut local = [0; D];
+    let mut rest = e;
+    for k in 0..D {
+        local[k] = rest % NODES_PER_AXIS;
+        rest /= NODES_PER_AXIS;
+        index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
+    }
+    (index, local)
+}
+
+/// GIMP: the box [x - half, x + half], cut to the grid, as a product of per-axis averages.
+fn fill_box<const D: usize>(
+    grid: &Grid<D>,
+    x: &SVector<f64, D>,
+    half: &SVector<f64, D>,
+    node: &mut [u32],
+    weight: &mut [f64],
+    grad: &mut [SVector<f64, D>],
+) -> Option<()> {
+    let inv_h = grid.inv_h();
+    let cells = grid.cells as f64;
+    let lo = SVector::<f64, D>::from_fn(|k, _| {
+        (((x[k] - half[k]) - grid.lower[k]) * inv_h).clamp(0.0, cells)
+    });
+    let hi = SVector::<f64, D>::from_fn(|k, _| {
+        (((x[k] + half[k]) - grid.lower[k]) * inv_h).clamp(0.0, cells)
+    });
+    let start = block_start(grid, &lo, &hi)?;
+    let mut value = [[0.0; NODES_PER_AXIS]; D];
+    let mut slope = [[0.0; NODES_PER_AXIS]; D];
+    for k in 0..D {
+        averaged_hats(lo[k], hi[k], start[k], &mut value[k], &mut slope[k]);
+    }
+    for e in 0..node.len() {
+        let (index, local) = block_node(grid, &start, e);
+        let mut w = 1.0;
+        let mut g = SVector::<f64, D>::repeat(inv_h);
+        for k in 0..D {
+            w *= value[k][local[k]];
+            for l in 0..D {
+                g[l] *= if l == k {
+                    slope[k][local[k]]
+                } else {
+                    value[k][local[k]]
+                };
+            }
+        }
+        node[e] = index as u32;
+        weight[e] = w;
+        grad[e] = g;
+    }
+    Some(())
+}
+
+/// CPDI: S_ip = sum_a w_a N_i(x_a), grad S_ip = sum_a g_a N_i(x_a) over the corners.
+fn fill_corners<const D: usize>(
+    grid: &Grid<D>,
+    corners: &[SVector<f64, D>],
+    cw: &cpdi::CornerWeights<D>,
+    node: &mut [u32],
+    weight: &mut [f64],
+    grad: &mut [SVector<f64, D>],
+) -> Option<()> {
+    let inv_h = grid.inv_h();
+    let local = |c: &SVector<f64, D>| (c - grid.lower) * inv_h;
+    let mut lo = local(&corners[0]);
+    let mut hi = lo;
+    for c in &corners[1..] {
+        lo = lo.inf(&local(c));
+        hi = hi.sup(&local(c));
+    }
+    let start = block_start(grid, &lo, &hi)?;
+    // hats[a][k][j]: the hat of the block's j-th node along axis k at corner a.
+    let mut hats = [[[0.0; NODES_PER_AXIS]; D]; MAX_CORNERS];
+    for (a, c) in corners.iter().enumerate() {
+        let s = local(c);
+        for k in 0..D {
+            for j in 0..NODES_PER_AXIS {
+                hats[a][k][j] = hat(s[k] - (start[k] + j) as f64);
+            }
+        }
+    }
+    for e in 0..node.len() {
+        let (index, at) = block_node(grid, &start, e);
+        let mut w = 0.0;
+        let mut g = SVector::<f64, D>::zeros();
+        for a in 0..corners.len() {
+            let n: f64 = (0..D).map(|k| hats[a][k][at[k]]).product();
+            w += cw.value[a] * n;
+            g += cw.gradient[a] * n;
+        }
+        node[e] = index as u32;
+        weight[e] = w;
+        grad[e] = g;
+    }
+    Some(())
+}
