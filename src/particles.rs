@@ -3,7 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::benchmarks::Problem;
-use crate::shape::Grid;
+use crate::shape::{lattice_coords, Grid};
 
 /// State carried by the material points. Velocities are the leapfrog half-step values
 /// v^{s-1/2} between steps (v^0 before the first).
@@ -37,12 +37,7 @@ pub struct SeedLattice<const D: usize> {
 impl<const D: usize> SeedLattice<D> {
     /// Sub-cell coordinates of particle `p`.
     pub fn cell_of(&self, p: usize) -> [usize; D] {
-        let mut rest = p;
-        std::array::from_fn(|k| {
-            let m = rest % self.per_axis[k];
-            rest /= self.per_axis[k];
-            m
-        })
+        lattice_coords(p, &self.per_axis)
     }
 }
 

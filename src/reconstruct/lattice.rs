@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use crate::shape::{axis_strides, Grid};
+use crate::shape::{lattice_strides, Grid};
 
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
@@ -20,7 +20,7 @@ pub struct Lattice<const D: usize> {
 
 impl<const D: usize> Lattice<D> {
     fn new(grid: &Grid<D>, offsets: Vec<f64>, per_axis: usize) -> Self {
-        let strides = axis_strides(per_axis);
+        let strides = lattice_strides(&[per_axis; D]);
         Lattice {
             lower: grid.lower,
             h: grid.h,

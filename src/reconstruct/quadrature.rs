@@ -9,7 +9,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{FitStats, GridState, Lattice, Recipe, Reconstructor, SingularMoments};
 use crate::particles::Particles;
-use crate::shape::{Grid, Shape, Stencils};
+use crate::shape::{Grid, LinearHat, Shape, Stencils};
 
 /// The parts of a quadrature transfer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,7 +26,8 @@ pub struct QuadratureRecipe {
 pub struct QuadratureTransfer<const D: usize> {
     velocity: Reconstructor<D>,
     fields: Reconstructor<D>,
-    /// N_i and grad N_i at the quadrature points: fixed, because the grid is reset each step.
+    /// N_i and grad N_i of the grid's hat at the quadrature points (whatever basis the
+    /// particles use): fixed, because the grid is reset each step.
     basis: Stencils<D>,
     /// Quadrature weights omega_g.
     weights: Vec<f64>,
@@ -37,14 +38,14 @@ pub struct QuadratureTransfer<const D: usize> {
 }
 
 impl<const D: usize> QuadratureTransfer<D> {
-    pub fn new<S: Shape<D>>(recipe: &QuadratureRecipe, grid: &Grid<D>, shape: &S) -> Self {
+    pub fn new(recipe: &QuadratureRecipe, grid: &Grid<D>) -> Self {
         let points = Lattice::gauss(grid, recipe.gauss_points);
         let n = points.len();
         let positions: Vec<SVector<f64, D>> = (0..n).map(|g| points.point(g)).collect();
         let weights = (0..n).map(|g| points.quadrature_weight(g)).collect();
-        let mut basis = Stencils::new(shape.nodes_per_point(), n);
+        let mut basis = Stencils::new(Shape::<D>::nodes_per_point(&LinearHat), n);
         basis
-            .update(shape, grid, &positions)
+            .update(&LinearHat, grid, &positions)
             .expect("quadrature points lie inside their cells");
         QuadratureTransfer {
             velocity: Reconstructor::new(recipe.velocity, Lattice::nodes(grid)),
@@ -111,7 +112,6 @@ mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem};
     use crate::methods;
-    use crate::shape::LinearHat;
 
     fn recipes() -> Vec<QuadratureRecipe> {
         methods::presets()
@@ -139,7 +139,7 @@ mod tests {
         let body = vec![b; particles.len()];
         let total: f64 = particles.mass.iter().sum();
         for recipe in recipes() {
-            let mut transfer = QuadratureTransfer::new(&recipe, &grid, &LinearHat);
+            let mut transfer = QuadratureTransfer::new(&recipe, &grid);
             let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
             let stats = transfer.map_to_grid(&particles, &body, &mut nodes).unwrap();
             assert_eq!(stats.rank_deficient, 0);

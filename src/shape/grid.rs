@@ -19,7 +19,7 @@ impl<const D: usize> Grid<D> {
     pub fn new(domain: &Domain<D>) -> Self {
         let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
         let n = domain.cells + 1;
-        let strides = axis_strides(n);
+        let strides = lattice_strides(&[n; D]);
         Grid {
             lower: domain.lower,
             h,
@@ -48,6 +48,12 @@ impl<const D: usize> Grid<D> {
     pub fn node_coords(&self, index: usize) -> [usize; D] {
         let n = self.nodes_per_dim();
         std::array::from_fn(|k| (index / self.strides[k]) % n)
+    }
+
+    /// Position of the node with flat index `index`.
+    pub fn node_position(&self, index: usize) -> SVector<f64, D> {
+        let ijk = self.node_coords(index);
+        SVector::from_fn(|k, _| self.lower[k] + ijk[k] as f64 * self.h)
     }
 
     /// The cell containing `x` and the local coordinates in [0, 1] within it, or `None`
@@ -80,12 +86,22 @@ impl<const D: usize> Grid<D> {
     }
 }
 
-/// Flat-index strides of a `D`-dimensional lattice with `per_axis` points along each axis,
+/// Flat-index strides of a `D`-dimensional lattice with `per_axis[k]` points along axis k,
 /// the first axis fastest.
-pub fn axis_strides<const D: usize>(per_axis: usize) -> [usize; D] {
+pub fn lattice_strides<const D: usize>(per_axis: &[usize; D]) -> [usize; D] {
     let mut strides = [1; D];
     for k in 1..D {
-        strides[k] = strides[k - 1] * per_axis;
+        strides[k] = strides[k - 1] * per_axis[k - 1];
     }
     strides
+}
+
+/// Integer coordinates of entry `index` of the same lattice.
+pub fn lattice_coords<const D: usize>(index: usize, per_axis: &[usize; D]) -> [usize; D] {
+    let mut rest = index;
+    std::array::from_fn(|k| {
+        let m = rest % per_axis[k];
+        rest /= per_axis[k];
+        m
+    })
 }

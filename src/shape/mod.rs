@@ -8,7 +8,7 @@ mod stencils;
 use nalgebra::SVector;
 
 pub use domain::{DomainFault, DomainShape, ParticleDomains};
-pub use grid::{axis_strides, Grid};
+pub use grid::{lattice_coords, lattice_strides, Grid};
 pub use linear::LinearHat;
 pub use stencils::Stencils;
 

@@ -78,11 +78,6 @@ mod tests {
             .collect()
     }
 
-    fn node_position<const D: usize>(g: &Grid<D>, i: usize) -> SVector<f64, D> {
-        let ijk = g.node_coords(i);
-        SVector::from_fn(|k, _| g.lower[k] + ijk[k] as f64 * g.h)
-    }
-
     /// Partition of unity, zero gradient sum, linear reproduction and its gradient.
     fn check_consistency<const D: usize>() {
         let g = grid::<D>(7);
@@ -92,10 +87,10 @@ mod tests {
         for (p, x) in xs.iter().enumerate() {
             let sum_w: f64 = st.of(p).map(|(_, w, _)| w).sum();
             let sum_g: SVector<f64, D> = st.of(p).map(|(_, _, gr)| *gr).sum();
-            let sum_wx: SVector<f64, D> = st.of(p).map(|(i, w, _)| node_position(&g, i) * w).sum();
+            let sum_wx: SVector<f64, D> = st.of(p).map(|(i, w, _)| g.node_position(i) * w).sum();
             let sum_gx: nalgebra::SMatrix<f64, D, D> = st
                 .of(p)
-                .map(|(i, _, gr)| node_position(&g, i) * gr.transpose())
+                .map(|(i, _, gr)| g.node_position(i) * gr.transpose())
                 .sum();
             assert!((sum_w - 1.0).abs() < 1e-14);
             assert!(sum_g.norm() < 1e-12);

@@ -39,8 +39,8 @@ pub fn simulate(spec: &RunSpec) -> RunRecord {
 /// A simulation: the problem stepped to its final time by the method.
 fn step(spec: &RunSpec) -> RunRecord {
     match prepare(spec) {
-        Ok((method, AnyProblem::D1(problem))) => run_with_method(spec, method, problem),
-        Ok((method, AnyProblem::D2(problem))) => run_with_method(spec, method, problem),
+        Ok((method, AnyProblem::D1(problem))) => Run::new(spec, method, problem).execute(),
+        Ok((method, AnyProblem::D2(problem))) => Run::new(spec, method, problem).execute(),
         Err(message) => base_record(spec, message),
     }
 }
@@ -55,14 +55,6 @@ fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
     })?;
     let problem = benchmarks::build(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
     Ok((preset.method, problem))
-}
-
-fn run_with_method<const D: usize>(
-    spec: &RunSpec,
-    method: Method,
-    problem: Box<dyn Problem<D>>,
-) -> RunRecord {
-    Run::new(spec, method, problem).execute()
 }
 
 /// The grid basis of a run as the particles see it.
@@ -111,8 +103,7 @@ impl<'a, const D: usize> Run<'a, D> {
             spec,
             method,
             stencils: Stencils::new(per_point, n),
-            // Quadrature points see the grid's own hat whatever the particles use.
-            transfer: Transfer::new(&method.transfer, &grid, &LinearHat),
+            transfer: Transfer::new(&method.transfer, &grid),
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],

@@ -9,7 +9,7 @@ use crate::reconstruct::{
     particles_to_grid, remap_velocity, FitStats, GridState, Lattice, QuadratureTransfer,
     Reconstructor,
 };
-use crate::shape::{Grid, Shape, Stencils};
+use crate::shape::{Grid, Stencils};
 
 pub enum Transfer<const D: usize> {
     Shepard,
@@ -19,11 +19,11 @@ pub enum Transfer<const D: usize> {
 }
 
 impl<const D: usize> Transfer<D> {
-    pub fn new<S: Shape<D>>(kind: &TransferKind, grid: &Grid<D>, shape: &S) -> Self {
+    pub fn new(kind: &TransferKind, grid: &Grid<D>) -> Self {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
             TransferKind::Quadrature(recipe) => {
-                Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid, shape)))
+                Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid)))
             }
             TransferKind::FittedVelocity(recipe) => Transfer::FittedVelocity(Box::new(
                 Reconstructor::new(*recipe, Lattice::nodes(grid)),

@@ -14,7 +14,7 @@ use std::fmt;
 
 use nalgebra::SVector;
 
-use super::{Grid, LinearHat, Shape, Stencils};
+use super::{lattice_coords, lattice_strides, Grid, LinearHat, Shape, Stencils};
 use crate::particles::Particles;
 use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
 use gimp::{averaged_hats, hat};
@@ -87,9 +87,10 @@ pub struct ParticleDomains<const D: usize> {
     half0: f64,
     /// CPDI2: the corners of the seed lattice, shared by neighbouring domains.
     corners: Vec<SVector<f64, D>>,
-    corner_strides: [usize; D],
     /// CPDI2: for each particle, the index of its lowest corner.
     first_corner: Vec<u32>,
+    /// CPDI2: index of corner a (in the order of `reference_corner`) less the lowest one.
+    corner_offset: [usize; MAX_CORNERS],
 }
 
 impl<const D: usize> ParticleDomains<D> {
@@ -100,32 +101,27 @@ impl<const D: usize> ParticleDomains<D> {
             shape,
             half0: 0.5 * lattice.spacing,
             corners: Vec::new(),
-            corner_strides: [0; D],
             first_corner: Vec::new(),
+            corner_offset: [0; MAX_CORNERS],
         };
         if shape == DomainShape::Quadrilateral {
             let points: [usize; D] = std::array::from_fn(|k| lattice.per_axis[k] + 1);
-            let mut stride = 1;
-            for k in 0..D {
-                domains.corner_strides[k] = stride;
-                stride *= points[k];
-            }
-            domains.corners = (0..stride)
+            let strides = lattice_strides(&points);
+            let count: usize = points.iter().product();
+            domains.corners = (0..count)
                 .map(|c| {
-                    SVector::from_fn(|k, _| {
-                        let m = c / domains.corner_strides[k] % points[k];
-                        lattice.lower[k] + m as f64 * lattice.spacing
-                    })
+                    let m = lattice_coords(c, &points);
+                    SVector::from_fn(|k, _| lattice.lower[k] + m[k] as f64 * lattice.spacing)
                 })
                 .collect();
+            let index = |m: [usize; D]| (0..D).map(|k| m[k] * strides[k]).sum::<usize>();
             domains.first_corner = (0..particles.len())
-                .map(|p| {
-                    let m = lattice.cell_of(p);
-                    (0..D)
-                        .map(|k| m[k] * domains.corner_strides[k])
-                        .sum::<usize>() as u32
-                })
+                .map(|p| index(lattice.cell_of(p)) as u32)
                 .collect();
+            for (a, offset) in domains.corner_offset.iter_mut().take(1 << D).enumerate() {
+                let r = reference_corner::<D>(a);
+                *offset = index(std::array::from_fn(|k| usize::from(r[k] > 0.0)));
+            }
         }
         domains
     }
@@ -143,6 +139,7 @@ impl<const D: usize> ParticleDomains<D> {
         stencils: &mut Stencils<D>,
     ) -> Result<(), DomainFault> {
         let mut corners = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        let corners = &mut corners[..1 << D];
         for p in 0..particles.len() {
             let range = p * stencils.per_point..(p + 1) * stencils.per_point;
             let node = &mut stencils.node[range.clone()];
@@ -152,33 +149,43 @@ impl<const D: usize> ParticleDomains<D> {
             if grid.locate(&x).is_none() {
                 return Err(DomainFault::Outside(p));
             }
-            match self.shape {
-                DomainShape::FixedBox | DomainShape::StretchedBox => {
-                    let half = SVector::<f64, D>::from_fn(|k, _| match self.shape {
-                        DomainShape::StretchedBox => self.half0 * particles.f[p][(k, k)],
-                        _ => self.half0,
-                    });
-                    fill_box(grid, &x, &half, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
-                }
-                DomainShape::Parallelogram | DomainShape::Quadrilateral => {
-                    for (a, corner) in corners.iter_mut().take(1 << D).enumerate() {
-                        *corner = if self.shape == DomainShape::Parallelogram {
-                            x + particles.f[p] * reference_corner::<D>(a) * self.half0
-                        } else {
-                            self.corners[self.corner_of(p, a)]
-                        };
-                        *corner = clamp_to_grid(grid, corner);
-                    }
-                    let cw = corner_weights(&corners[..1 << D]).ok_or(DomainFault::Inverted(p))?;
-                    fill_corners(grid, &corners[..1 << D], &cw, node, weight, grad)
-                        .ok_or(DomainFault::TooWide(p))?;
-                    if self.shape == DomainShape::Quadrilateral {
-                        particles.volume[p] = cw.volume;
-                    }
-                }
+            if let Some(half) = self.box_half_widths(particles, p) {
+                fill_box(grid, &x, &half, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
+                continue;
+            }
+            self.corners_of(particles, p, corners);
+            for corner in corners.iter_mut() {
+                *corner = clamp_to_grid(grid, corner);
+            }
+            let cw = corner_weights(corners).ok_or(DomainFault::Inverted(p))?;
+            fill_corners(grid, corners, &cw, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
+            if self.shape == DomainShape::Quadrilateral {
+                particles.volume[p] = cw.volume;
             }
         }
         Ok(())
+    }
+
+    /// GIMP: the half-widths of particle `p`'s box; `None` for CPDI, whose domains are
+    /// given by corners.
+    fn box_half_widths(&self, particles: &Particles<D>, p: usize) -> Option<SVector<f64, D>> {
+        match self.shape {
+            DomainShape::FixedBox => Some(SVector::repeat(self.half0)),
+            DomainShape::StretchedBox => Some(particles.f[p].diagonal() * self.half0),
+            DomainShape::Parallelogram | DomainShape::Quadrilateral => None,
+        }
+    }
+
+    /// CPDI: the corners of particle `p`'s domain in the order of `reference_corner`, before
+    /// they are moved onto the grid.
+    fn corners_of(&self, particles: &Particles<D>, p: usize, out: &mut [SVector<f64, D>]) {
+        for (a, corner) in out.iter_mut().enumerate() {
+            *corner = if self.shape == DomainShape::Quadrilateral {
+                self.corners[self.first_corner[p] as usize + self.corner_offset[a]]
+            } else {
+                particles.x[p] + particles.f[p] * reference_corner::<D>(a) * self.half0
+            };
+        }
     }
 
     /// CPDI2 (eq 6.28): every corner moves with the grid velocity interpolated by the hat,
@@ -206,21 +213,6 @@ impl<const D: usize> ParticleDomains<D> {
             *corner += v * dt;
         }
         Ok(())
-    }
-
-    /// Index of corner `a` (in the order of `reference_corner`) of particle `p`'s domain.
-    fn corner_of(&self, p: usize, a: usize) -> usize {
-        let r = reference_corner::<D>(a);
-        let offset: usize = (0..D)
-            .map(|k| {
-                if r[k] > 0.0 {
-                    self.corner_strides[k]
-                } else {
-                    0
-                }
-            })
-            .sum();
-        self.first_corner[p] as usize + offset
     }
 }
 

@@ -39,11 +39,6 @@ fn deformed<const D: usize>(
     (grid, particles, domains, stencils)
 }
 
-fn node_position<const D: usize>(grid: &Grid<D>, i: usize) -> SVector<f64, D> {
-    let ijk = grid.node_coords(i);
-    SVector::from_fn(|k, _| grid.lower[k] + ijk[k] as f64 * grid.h)
-}
-
 /// The domain of particle `p` as its corners (boxes as their four corners), cut to the grid.
 fn domain_corners<const D: usize>(
     grid: &Grid<D>,
@@ -51,20 +46,16 @@ fn domain_corners<const D: usize>(
     domains: &ParticleDomains<D>,
     p: usize,
 ) -> Vec<SVector<f64, D>> {
-    (0..1 << D)
-        .map(|a| {
-            let r = reference_corner::<D>(a);
-            let c = match domains.shape {
-                DomainShape::FixedBox => particles.x[p] + r * domains.half0,
-                DomainShape::StretchedBox => {
-                    particles.x[p] + particles.f[p].diagonal().component_mul(&r) * domains.half0
-                }
-                DomainShape::Parallelogram => particles.x[p] + particles.f[p] * r * domains.half0,
-                DomainShape::Quadrilateral => domains.corners[domains.corner_of(p, a)],
-            };
-            clamp_to_grid(grid, &c)
-        })
-        .collect()
+    let mut corners = vec![SVector::zeros(); 1 << D];
+    match domains.box_half_widths(particles, p) {
+        Some(half) => {
+            for (a, c) in corners.iter_mut().enumerate() {
+                *c = particles.x[p] + half.component_mul(&reference_corner::<D>(a));
+            }
+        }
+        None => domains.corners_of(particles, p, &mut corners),
+    }
+    corners.iter().map(|c| clamp_to_grid(grid, c)).collect()
 }
 
 /// Partition of unity, zero gradient sum, sum_i x_i S_ip = the domain's centroid and
@@ -75,11 +66,10 @@ fn check_consistency<const D: usize>() {
         for p in 0..particles.len() {
             let sum_w: f64 = st.of(p).map(|(_, w, _)| w).sum();
             let sum_g: SVector<f64, D> = st.of(p).map(|(_, _, g)| *g).sum();
-            let first: SVector<f64, D> =
-                st.of(p).map(|(i, w, _)| node_position(&grid, i) * w).sum();
+            let first: SVector<f64, D> = st.of(p).map(|(i, w, _)| grid.node_position(i) * w).sum();
             let second: SMatrix<f64, D, D> = st
                 .of(p)
-                .map(|(i, _, g)| node_position(&grid, i) * g.transpose())
+                .map(|(i, _, g)| grid.node_position(i) * g.transpose())
                 .sum();
             let corners = domain_corners(&grid, &particles, &domains, p);
             let centroid = match shape {
@@ -277,15 +267,15 @@ fn one_dimensional_parallelogram_and_quadrilateral_agree() {
     let (grid, mut particles, mut quad, _) = deformed::<1>(DomainShape::Quadrilateral, 11);
     let para = ParticleDomains::new(DomainShape::Parallelogram, &particles);
     for p in 0..particles.len() {
-        let c0 = quad.corner_of(p, 0);
-        quad.corners[c0 + 1] =
+        let c0 = quad.first_corner[p] as usize;
+        quad.corners[c0 + quad.corner_offset[1]] =
             quad.corners[c0] + particles.f[p] * SVector::repeat(2.0 * quad.half0);
     }
     // Centres at the middle of the tracked intervals, F from their lengths.
     for p in 0..particles.len() {
         let (l, r) = (
-            quad.corners[quad.corner_of(p, 0)],
-            quad.corners[quad.corner_of(p, 1)],
+            quad.corners[quad.first_corner[p] as usize],
+            quad.corners[quad.first_corner[p] as usize + quad.corner_offset[1]],
         );
         particles.x[p] = (l + r) / 2.0;
         particles.f[p] = SMatrix::repeat((r - l)[0] / (2.0 * quad.half0));
