@@ -2,13 +2,15 @@
 //!
 //! Layers, top to bottom: `experiment` (YAML, matrix), `runner` (runs a matrix in parallel),
 //! `output` (HDF5 layout), `report` (rates, tables, figures), `solver` (one run),
-//! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`.
+//! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`. `linear_stability` holds
+//! the predicted stability bounds that `report` draws beside measured ones.
 
 pub mod benchmarks;
 pub mod collect;
 
 pub mod experiment;
 pub mod integrate;
+pub mod linear_stability;
 pub mod material;
 pub mod methods;
 pub mod output;

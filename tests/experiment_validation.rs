@@ -1011,3 +1011,82 @@ fn figures_and_tables_must_suit_the_benchmark() {
         &["l2", "max"],
     );
 }
+
+const STABILITY: &str = "\
+name: stab
+benchmark: mms1d_gong
+params: {method: mpm, nu: 0.0, G: 1.0e-4, cells: 16, courant_limit: 2.0}
+matrix:
+  ppc: [1, 2]
+  cfl: [0.6, 0.8]
+expect:
+  - {ppc: 1, sweep: cfl, limit_min: 0.6, limit_max: 0.8}
+figures:
+  - {kind: stability, x: ppc, sweep: cfl}
+  - {kind: growth, sweep: cfl}
+tables:
+  - {kind: stability, x: ppc, sweep: cfl}
+";
+
+#[test]
+fn stability_studies_read_their_axes() {
+    let exp = parse(STABILITY).unwrap();
+    assert_eq!(exp.runs.len(), 4);
+    let limit = exp.expect[0].limit.as_ref().unwrap();
+    assert_eq!(
+        (limit.sweep.as_str(), limit.min, limit.max),
+        ("cfl", 0.6, 0.8)
+    );
+    assert_eq!(exp.expect[0].field, "velocity");
+    assert_eq!(exp.figures[0].kind, FigureKind::Stability);
+    let axes = exp.figures[0].stability.as_ref().unwrap();
+    assert_eq!(
+        (axes.sweep.as_str(), axes.x.as_deref()),
+        ("cfl", Some("ppc"))
+    );
+    assert_eq!(exp.figures[1].stability.as_ref().unwrap().x, None);
+    assert!(exp.tables[0].stability.is_some());
+    // Without courant_limit a sweep past Courant number 1 is refused at the value.
+    let text = edited_in(STABILITY, ", courant_limit: 2.0", "").replace("0.8]", "1.2]");
+    let e = error(&text);
+    check(&e, 6, 14, "matrix.cfl[1]", "raise courant_limit", &[]);
+    assert!(e.message.contains("Use cfl <= 1.0000"), "{e}");
+}
+
+/// One bad edit of a valid file and where its error must point: (base file, from, to, line,
+/// column, field, part of the message, valid choices listed).
+type Case = (
+    &'static str,
+    &'static str,
+    &'static str,
+    usize,
+    usize,
+    &'static str,
+    &'static str,
+    &'static [&'static str],
+);
+
+#[test]
+fn stability_keys_are_located_with_their_choices() {
+    let growth = "{kind: growth, sweep: cfl}";
+    let table = "tables:\n  - {kind: stability, x: ppc, sweep: cfl}";
+    #[rustfmt::skip]
+    let cases: [Case; 12] = [
+        (STABILITY, "x: ppc, sweep: cfl}\n  - {kind: growth", "x: cfl, sweep: cfl}\n  - {kind: growth", 10, 26, "figures[0].x", "already the swept axis", &["ppc"]),
+        (STABILITY, growth, "{kind: growth}", 11, 5, "figures[1].sweep", "missing required key 'sweep'", &["ppc", "cfl"]),
+        (STABILITY, growth, "{kind: growth, sweep: G}", 11, 27, "figures[1].sweep", "'G' is not a matrix axis", &["ppc", "cfl"]),
+        (STABILITY, growth, "{kind: growth, x: ppc, sweep: cfl}", 11, 20, "figures[1].x", "'x' applies to stability figures only", &[]),
+        (STABILITY, growth, "{kind: convergence, sweep: cfl}", 11, 25, "figures[1].sweep", "applies to stability and growth figures only", &[]),
+        (STABILITY, growth, "{kind: growth, sweep: cfl, cfl: 0.6}", 11, 27, "figures[1].sweep", "also selects runs", &[]),
+        (STABILITY, table, "tables:\n  - {kind: stability, x: ppc, sweep: cfl, columns: ppc}", 13, 43, "tables[0].columns", "applies to nodal_errors tables only", &[]),
+        (STABILITY, "limit_max: 0.8", "limit_max: 0.5", 8, 53, "expect[0].limit_max", "below limit_min 0.6", &[]),
+        (STABILITY, ", limit_max: 0.8", "", 8, 5, "expect[0].limit_max", "missing required key", &[]),
+        (STABILITY, "sweep: cfl, limit_min", "sweep: cfl, field: stress, limit_min", 8, 26, "expect[0].field", "does not apply to a stability-limit expectation", &[]),
+        (STABILITY, "sweep: cfl, limit_min", "field: velocity, rate_min: 1.0, limit_min", 8, 46, "expect[0].limit_min", "needs 'sweep'", &[]),
+        (RECONSTRUCTION, "{kind: reconstruction, method: mls_linear}", "{kind: stability, x: cells, sweep: spacing}", 10, 12, "figures[0].kind", "a stability figure needs data that nodal reconstruction benchmarks do not record", &[]),
+    ];
+    for (base, from, to, line, column, field, message, valid) in cases {
+        let e = error(&edited_in(base, from, to));
+        check(&e, line, column, field, message, valid);
+    }
+}

@@ -59,6 +59,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
         final_norms,
         reconstruction: None,
+        velocity_history: None,
     }
 }
 
@@ -119,6 +120,7 @@ fn expect(line: usize, select: &[(&str, &str)], field: &str) -> Expectation {
         rate_min: None,
         rate_max: None,
         error_max: None,
+        limit: None,
         line,
     }
 }
@@ -327,6 +329,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         norm: "rms".into(),
         by: Some("G".into()),
         select: Params::new(),
+        stability: None,
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let dir = tempfile::tempdir().unwrap();

@@ -47,6 +47,13 @@ const PARAMS: &[ParamSpec] = &[
         unit: "1",
         doc: "dt = cfl h / c with c = sqrt(E/rho0); dt is then shortened so t_end is hit exactly",
     },
+    ParamSpec {
+        key: "courant_limit",
+        kind: ParamKind::PositiveReal,
+        default: ParamDefault::Float(1.0),
+        unit: "1",
+        doc: "largest accepted Courant number dt c_p / h; raise it only to study instability",
+    },
     PPC,
     CELLS,
 ];
@@ -92,19 +99,26 @@ fn check_params(params: &Params) -> Result<(), ParamError> {
     }
     let e = get_f64(params, "E")?;
     let cfl = get_f64(params, "cfl")?;
+    let limit = get_f64(params, "courant_limit")?;
     let (lambda, mu) = lame_from_young(e, nu);
     // Gong eq 7.32: stable when the Courant number with the true wave speed is <= 1. The
     // wave speed of the linearised neo-Hookean model is sqrt((lambda + 2 mu)/rho0), not c.
+    // `courant_limit` (default 1) moves the bound only for studies of the instability.
     let ratio = ((lambda + 2.0 * mu) / e).sqrt();
-    if cfl * ratio > 1.0 {
+    if cfl * ratio > limit {
+        let why = if limit == 1.0 {
+            "the explicit scheme is unstable (Gong eq 7.32)".to_string()
+        } else {
+            format!("above courant_limit = {limit}")
+        };
         return Err(ParamError::new(
             "cfl",
             format!(
-                "cfl = {cfl} gives the Courant number dt c_p / h = {:.4} > 1, with the P-wave \
-                 speed c_p = sqrt((lambda + 2 mu)/rho0) = {ratio:.4} c; the explicit scheme is \
-                 unstable (Gong eq 7.32). Use cfl <= {:.4}",
+                "cfl = {cfl} gives the Courant number dt c_p / h = {:.4} > {limit}, with the \
+                 P-wave speed c_p = sqrt((lambda + 2 mu)/rho0) = {ratio:.4} c; {why}. Use \
+                 cfl <= {:.4}, or raise courant_limit to study the instability",
                 cfl * ratio,
-                1.0 / ratio
+                limit / ratio
             ),
         ));
     }
@@ -122,6 +136,7 @@ pub fn thesis_params(g: f64, cells: i64, ppc: i64) -> Params {
         ("rho0", 1e3),
         ("t_end", 0.02),
         ("cfl", 0.4),
+        ("courant_limit", 1.0),
     ] {
         p.insert(k.into(), crate::params::ParamValue::Float(v));
     }
@@ -198,5 +213,24 @@ mod tests {
         assert_eq!(check_params(&p).unwrap_err().key, "cfl");
         let p = thesis_params(0.4, 8, 2);
         assert_eq!(check_params(&p).unwrap_err().key, "G");
+    }
+
+    #[test]
+    fn courant_limit_moves_the_bound_for_stability_studies() {
+        // nu = 0.3: c_p = 1.1602 c, so cfl 1.2 is the Courant number 1.392.
+        let mut p = thesis_params(1e-4, 8, 2);
+        p.insert("cfl".into(), ParamValue::Float(1.2));
+        let e = check_params(&p).unwrap_err();
+        assert!(e.message.contains("Use cfl <= 0.8619"), "{e}");
+        assert!(e.message.contains("raise courant_limit"), "{e}");
+        p.insert("courant_limit".into(), ParamValue::Float(1.5));
+        assert!(check_params(&p).is_ok());
+        p.insert("cfl".into(), ParamValue::Float(1.3));
+        let e = check_params(&p).unwrap_err();
+        assert_eq!(e.key, "cfl");
+        assert!(
+            e.message.contains("> 1.5") && e.message.contains("Use cfl <= 1.2928"),
+            "{e}"
+        );
     }
 }

@@ -8,19 +8,21 @@ use super::kinds::{Item, Kinds};
 use super::measures::{error_field, norm};
 use super::select::axis_key;
 use super::space::ParamSpace;
+use super::stability;
 use super::yaml::{child_field, find, item_field, Entry, Node};
 use super::{FigureKind, FigureSpec};
 
-/// The keys only a convergence figure takes.
-const CONVERGENCE_KEYS: [&str; 3] = ["fields", "norm", "by"];
 const KINDS: Kinds<FigureKind> = Kinds {
     what: "figure",
     kinds: &[
         ("convergence", FigureKind::Convergence),
         ("reconstruction", FigureKind::Reconstruction),
         ("basis", FigureKind::Basis),
+        ("stability", FigureKind::Stability),
+        ("growth", FigureKind::Growth),
     ],
-    keys: &["kind", "fields", "norm", "by"],
+    keys: &["kind", "fields", "norm", "by", "x", "sweep"],
+    takes,
     suits: draws_for,
 };
 
@@ -40,21 +42,20 @@ fn figure(
     benchmark: BenchmarkKind,
 ) -> Result<FigureSpec, ConfigError> {
     let Item {
+        node,
         parent,
         entries,
         kind,
         select,
-        ..
     } = item;
-    if *kind != FigureKind::Convergence {
-        if let Some(e) = entries.iter().find(|e| CONVERGENCE_KEYS.contains(&e.key)) {
-            return Err(ConfigError::at(
-                e.key_pos,
-                child_field(parent, e.key),
-                format!("'{}' applies to convergence figures only", e.key),
-            ));
+    let stability = match kind {
+        FigureKind::Stability | FigureKind::Growth => {
+            let with_x = *kind == FigureKind::Stability;
+            let axes = stability::axes(&entries, node, parent, space, &select, with_x)?;
+            Some(axes)
         }
-    }
+        _ => None,
+    };
     let measures = Measures::of(benchmark);
     let fields = match find(&entries, "fields") {
         Some(e) => fields(e.value, &child_field(parent, "fields"), measures)?,
@@ -70,7 +71,18 @@ fn figure(
         norm: norm(&entries, parent, measures)?,
         by,
         select,
+        stability,
     })
+}
+
+/// The keys a figure of `kind` takes besides `kind` and selectors.
+fn takes(kind: &FigureKind) -> &'static [&'static str] {
+    match kind {
+        FigureKind::Convergence => &["fields", "norm", "by"],
+        FigureKind::Reconstruction | FigureKind::Basis => &[],
+        FigureKind::Stability => &["x", "sweep"],
+        FigureKind::Growth => &["sweep"],
+    }
 }
 
 /// Whether runs of `benchmark` hold what a figure of `kind` shows.
@@ -79,6 +91,7 @@ fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
         FigureKind::Convergence => true,
         FigureKind::Reconstruction => benchmark.is_reconstruction(),
         FigureKind::Basis => benchmark == BenchmarkKind::OrthogonalBasis,
+        FigureKind::Stability | FigureKind::Growth => benchmark == BenchmarkKind::Simulation,
     }
 }
 

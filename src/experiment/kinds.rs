@@ -10,12 +10,14 @@ use super::space::ParamSpace;
 use super::values::pick;
 use super::yaml::{child_field, read_list, require, Entry, Node};
 
-/// Named kinds of a `what` (figure, table), the keys its items take besides axis values, and
-/// which benchmarks record what each kind shows.
+/// Named kinds of a `what` (figure, table), the keys its items take besides axis values, which
+/// of them each kind takes, and which benchmarks record what each kind shows.
 pub(crate) struct Kinds<K: 'static> {
     pub what: &'static str,
     pub kinds: &'static [(&'static str, K)],
+    /// `kind` and every key of `takes` of any kind.
     pub keys: &'static [&'static str],
+    pub takes: fn(&K) -> &'static [&'static str],
     pub suits: fn(&K, BenchmarkKind) -> bool,
 }
 
@@ -42,6 +44,7 @@ impl<K> Kinds<K> {
             let entries = node.entries(parent)?;
             let select = selection(&entries, parent, space, self.keys)?;
             let kind = self.kind(&entries, node, parent, benchmark)?;
+            self.reject_others_keys(&entries, kind, parent)?;
             read(Item {
                 node,
                 parent,
@@ -50,6 +53,38 @@ impl<K> Kinds<K> {
                 select,
             })
         })
+    }
+
+    /// An error at the first key that another kind takes but `kind` does not.
+    fn reject_others_keys(
+        &self,
+        entries: &[Entry],
+        kind: &K,
+        parent: &str,
+    ) -> Result<(), ConfigError> {
+        let own = (self.takes)(kind);
+        let foreign = entries
+            .iter()
+            .find(|e| e.key != "kind" && self.keys.contains(&e.key) && !own.contains(&e.key));
+        let Some(e) = foreign else {
+            return Ok(());
+        };
+        let takers: Vec<&str> = self
+            .kinds
+            .iter()
+            .filter(|(_, k)| (self.takes)(k).contains(&e.key))
+            .map(|(name, _)| *name)
+            .collect();
+        Err(ConfigError::at(
+            e.key_pos,
+            child_field(parent, e.key),
+            format!(
+                "'{}' applies to {} {}s only",
+                e.key,
+                takers.join(" and "),
+                self.what
+            ),
+        ))
     }
 
     /// The kind named by the required `kind` entry of the map `node` at `parent`.

@@ -12,6 +12,7 @@ mod run_id;
 mod run_spec;
 mod select;
 mod space;
+mod stability;
 mod tables;
 mod values;
 mod yaml;
@@ -129,8 +130,30 @@ pub struct Expectation {
     pub rate_max: Option<f64>,
     /// Upper bound on the final error of every matching run.
     pub error_max: Option<f64>,
+    /// A stability-limit expectation (`sweep`, `limit_min`, `limit_max`); its `field` and
+    /// `norm` are those the stability criterion reads (velocity, l2).
+    pub limit: Option<LimitBound>,
     /// Line of the entry in the source file, for messages.
     pub line: usize,
+}
+
+/// The measured stability limit along `sweep` must lie in [min, max]: in every group of the
+/// other axes the last stable value is at least `min` and the first unstable one at most
+/// `max`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitBound {
+    pub sweep: String,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// The axes of a stability study: `sweep`, along which runs are taken towards instability,
+/// and `x`, whose values are a stability figure's abscissa and a stability table's rows
+/// (none for growth figures, which draw one figure per group).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StabilityAxes {
+    pub sweep: String,
+    pub x: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -141,6 +164,11 @@ pub enum FigureKind {
     Reconstruction,
     /// Per run: the weighted orthogonal polynomials with the data points on them.
     Basis,
+    /// The measured stability limit along `sweep` (last stable and first unstable value)
+    /// against `x`, with the predicted bounds when `x` is the particles per cell.
+    Stability,
+    /// Per group: the l2 velocity error over time of the runs on either side of the limit.
+    Growth,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -152,6 +180,8 @@ pub struct FigureSpec {
     pub by: Option<String>,
     /// Axis values a run must have to be drawn; empty = every run.
     pub select: Params,
+    /// Stability and growth figures only.
+    pub stability: Option<StabilityAxes>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -160,6 +190,9 @@ pub enum TableKind {
     NodalErrors,
     /// <p_i, p_i> and the kept polynomials, one row per run (Tran Figs 1-3).
     BasisNorms,
+    /// One row per value of `x`: the measured stability limit along `sweep` and the
+    /// predicted bounds.
+    Stability,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -169,4 +202,6 @@ pub struct TableSpec {
     pub columns: Option<String>,
     /// Axis values a run must have to be listed; empty = every run.
     pub select: Params,
+    /// Stability tables only.
+    pub stability: Option<StabilityAxes>,
 }

@@ -1,6 +1,6 @@
-//! `tables` entries: the tables of pointwise values that report.md prints beside the rates
-//! (the reconstruction benchmarks' counterparts of Gong's Tables 4.1-4.2 and of the
-//! <p_i, p_i> of Tran's Figs 1-3).
+//! `tables` entries: the tables that report.md prints beside the rates: pointwise values of
+//! the reconstruction benchmarks (the counterparts of Gong's Tables 4.1-4.2 and of the
+//! <p_i, p_i> of Tran's Figs 1-3) and measured stability limits.
 
 use crate::benchmarks::BenchmarkKind;
 
@@ -8,6 +8,7 @@ use super::error::ConfigError;
 use super::kinds::{Item, Kinds};
 use super::select::axis_key;
 use super::space::ParamSpace;
+use super::stability;
 use super::yaml::{child_field, find, Entry};
 use super::{TableKind, TableSpec};
 
@@ -16,8 +17,10 @@ const KINDS: Kinds<TableKind> = Kinds {
     kinds: &[
         ("nodal_errors", TableKind::NodalErrors),
         ("basis_norms", TableKind::BasisNorms),
+        ("stability", TableKind::Stability),
     ],
-    keys: &["kind", "columns"],
+    keys: &["kind", "columns", "x", "sweep"],
+    takes,
     suits: lists_for,
 };
 
@@ -49,20 +52,29 @@ fn table(item: Item<TableKind>, space: &ParamSpace) -> Result<TableSpec, ConfigE
             )
             .with_valid(space.group_axis_names()))
         }
-        (TableKind::BasisNorms, Some(e)) => {
-            return Err(ConfigError::at(
-                e.key_pos,
-                child_field(parent, "columns"),
-                "a basis_norms table has one row per run and takes no 'columns'",
-            ))
-        }
-        (TableKind::BasisNorms, None) => None,
+        _ => None,
+    };
+    let stability = match kind {
+        TableKind::Stability => Some(stability::axes(
+            &entries, node, parent, space, &select, true,
+        )?),
+        _ => None,
     };
     Ok(TableSpec {
         kind: kind.clone(),
         columns,
         select,
+        stability,
     })
+}
+
+/// The keys a table of `kind` takes besides `kind` and selectors.
+fn takes(kind: &TableKind) -> &'static [&'static str] {
+    match kind {
+        TableKind::NodalErrors => &["columns"],
+        TableKind::BasisNorms => &[],
+        TableKind::Stability => &["x", "sweep"],
+    }
 }
 
 /// Whether runs of `benchmark` hold what a table of `kind` lists.
@@ -70,5 +82,6 @@ fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
     match kind {
         TableKind::NodalErrors => benchmark.is_reconstruction(),
         TableKind::BasisNorms => benchmark == BenchmarkKind::OrthogonalBasis,
+        TableKind::Stability => benchmark == BenchmarkKind::Simulation,
     }
 }

@@ -92,6 +92,21 @@ pub struct RunSummary {
     pub final_norms: BTreeMap<(String, String), f64>,
     /// The `/reconstruction` group of a reconstruction run, which its figures and tables show.
     pub reconstruction: Option<ReconstructionRecord>,
+    /// The l2 velocity error at every sample of a simulation run that took any.
+    pub velocity_history: Option<VelocityHistory>,
+}
+
+/// The l2 velocity error over a run beside the size of the solution, which is what a
+/// stability study needs to tell a run whose error grew (`report`'s stability kinds).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VelocityHistory {
+    /// `/errors/time`.
+    pub time: Vec<f64>,
+    /// `/errors/norms/l2_velocity`.
+    pub l2_error: Vec<f64>,
+    /// sqrt(sum_p V_p |v_p|^2) of the first sample (t = 0), where the particles carry the
+    /// exact initial velocity.
+    pub initial_l2: f64,
 }
 
 mod atomic;

@@ -3,8 +3,9 @@ use std::path::Path;
 
 use hdf5::types::{TypeDescriptor, VarLenUnicode};
 use hdf5::Location;
+use ndarray::s;
 
-use super::{reconstruction, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use super::{reconstruction, RunStatus, RunSummary, VelocityHistory, ERROR_FIELDS, NORMS};
 use super::{RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
 use crate::params::{ParamValue, Params};
 
@@ -17,12 +18,13 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let status = RunStatus::parse(&status_text)
         .ok_or_else(|| format!("{}: unknown status '{status_text}'", path.display()))?;
     let reconstruction = reconstruction::read(&file).map_err(context)?;
-    let (final_norms, steps, dt) = match &reconstruction {
-        Some(r) => (reconstruction_norms(r.l2, r.max), 0, f64::NAN),
+    let (final_norms, steps, dt, velocity_history) = match &reconstruction {
+        Some(r) => (reconstruction_norms(r.l2, r.max), 0, f64::NAN, None),
         None => (
             simulation_norms(&file).map_err(context)?,
             read_i64(&file, "steps").map_err(context)? as usize,
             read_f64(&file, "dt").map_err(context)?,
+            velocity_history(&file).map_err(context)?,
         ),
     };
     let matrix = file.group("matrix").map_err(context)?;
@@ -43,7 +45,38 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         axes: read_params(&matrix).map_err(context)?,
         final_norms,
         reconstruction,
+        velocity_history,
     })
+}
+
+/// The l2 velocity error per sample and the l2 norm of the velocity at the first sample;
+/// `None` for a run without samples (a failed run's datasets are empty). Reads only the first
+/// row of `/history/v` and `/errors/volume`.
+fn velocity_history(file: &hdf5::File) -> hdf5::Result<Option<VelocityHistory>> {
+    let time = file.dataset("errors/time")?.read_raw::<f64>()?;
+    if time.is_empty() {
+        return Ok(None);
+    }
+    let l2_error = file
+        .dataset("errors/norms/l2_velocity")?
+        .read_raw::<f64>()?;
+    let v = file
+        .dataset("history/v")?
+        .read_slice_2d::<f64, _>(s![0, .., ..])?;
+    let volume = file
+        .dataset("errors/volume")?
+        .read_slice_1d::<f64, _>(s![0, ..])?;
+    let sum: f64 = v
+        .rows()
+        .into_iter()
+        .zip(&volume)
+        .map(|(vp, w)| w * vp.iter().map(|c| c * c).sum::<f64>())
+        .sum();
+    Ok(Some(VelocityHistory {
+        time,
+        l2_error,
+        initial_l2: sum.sqrt(),
+    }))
 }
 
 type FinalNorms = BTreeMap<(String, String), f64>;

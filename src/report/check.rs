@@ -1,12 +1,13 @@
-//! `report --check`: holds the fitted rates and final errors against the experiment's
-//! `expect` entries.
+//! `report --check`: holds the fitted rates, final errors and measured stability limits
+//! against the experiment's `expect` entries.
 
 use std::fmt;
 
 use super::format::{exact, general};
 use super::group::{label, ordered_runs, selects};
+use super::stability::{group_name, limits};
 use super::RateRow;
-use crate::experiment::{Expectation, Experiment};
+use crate::experiment::{Expectation, Experiment, LimitBound};
 use crate::output::{RunStatus, RunSummary};
 
 /// One unmet expectation. `message` names the group, field, norm, value and bound; the
@@ -28,6 +29,7 @@ impl fmt::Display for CheckFailure {
 /// Rate bounds apply to every fitted rate whose group matches the selector, and fail when
 /// none does. `error_max` applies to every run whose axes match the selector (the
 /// refinement axis included): each must have finished with a final error within the bound.
+/// A limit bound applies to every group of the other axes along its swept axis.
 pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) -> Vec<CheckFailure> {
     experiment
         .expect
@@ -35,6 +37,7 @@ pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) ->
         .flat_map(|e| {
             let mut messages = check_rates(e, rates);
             messages.extend(check_errors(e, runs));
+            messages.extend(check_limit(e, runs));
             messages.into_iter().map(|message| CheckFailure {
                 line: e.line,
                 message,
@@ -45,6 +48,15 @@ pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) ->
 
 /// A one-line statement of what `e` requires, e.g. `method=mpm velocity l2: rate >= 1.8`.
 pub fn describe(e: &Expectation) -> String {
+    if let Some(LimitBound { sweep, min, max }) = &e.limit {
+        let at = label(&e.select);
+        let at = if at.is_empty() { at } else { format!("{at} ") };
+        return format!(
+            "{at}stability limit along {sweep}: last stable >= {}, first unstable <= {}",
+            exact(*min),
+            exact(*max)
+        );
+    }
     let bounds: Vec<String> = [
         e.rate_min.map(|v| format!("rate >= {}", exact(v))),
         e.rate_max.map(|v| format!("rate <= {}", exact(v))),
@@ -125,6 +137,44 @@ fn check_errors(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
             }
         })
         .collect()
+}
+
+/// In every group of the selected runs, the last stable value of the swept axis must be at
+/// least `min` and the first unstable one at most `max`.
+fn check_limit(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
+    let Some(LimitBound { sweep, min, max }) = &e.limit else {
+        return Vec::new();
+    };
+    let selected = runs.iter().filter(|run| selects(&e.select, &run.axes));
+    let groups = limits(selected, sweep);
+    if groups.is_empty() {
+        return vec![format!("no run for {}", describe(e))];
+    }
+    let mut messages = Vec::new();
+    for limit in &groups {
+        let at = group_name(&limit.axes);
+        match limit.last_stable() {
+            None => messages.push(format!("{at}: no stable run along {sweep}")),
+            Some(p) if p.value < *min => messages.push(format!(
+                "{at}: last stable {sweep} {} < limit_min {} (run {})",
+                beside(p.value, *min),
+                exact(*min),
+                p.run.run_id
+            )),
+            Some(_) => {}
+        }
+        match limit.first_unstable() {
+            None => messages.push(format!("{at}: no unstable run along {sweep}")),
+            Some(p) if p.value > *max => messages.push(format!(
+                "{at}: first unstable {sweep} {} > limit_max {} (run {})",
+                beside(p.value, *max),
+                exact(*max),
+                p.run.run_id
+            )),
+            Some(_) => {}
+        }
+    }
+    messages
 }
 
 /// `<group> <field> <norm>`, or just `<field> <norm>` when the group has no axes.

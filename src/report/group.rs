@@ -82,6 +82,24 @@ pub fn label(axes: &Params) -> String {
         .join(" ")
 }
 
+/// A group's label for titles and file names, `all` for a group without axes.
+pub fn label_or_all(label: &str) -> String {
+    if label.is_empty() {
+        "all".into()
+    } else {
+        label.to_string()
+    }
+}
+
+/// `: <label>` to end a title with the group, empty for a group without axes.
+pub fn title_suffix(label: &str) -> String {
+    if label.is_empty() {
+        String::new()
+    } else {
+        format!(": {label}")
+    }
+}
+
 /// Whether `axes` holds every key of `select` with the same value.
 pub fn selects(select: &Params, axes: &Params) -> bool {
     select

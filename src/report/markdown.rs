@@ -28,7 +28,7 @@ pub fn report_md(
     overview(&mut md, experiment, &runs);
     runs_table(&mut md, experiment, &runs);
     rates_table(&mut md, rates);
-    unfinished(&mut md, &runs);
+    unfinished(&mut md, experiment, &runs);
     if !tables.is_empty() {
         md.push_str("## Tables\n\n");
         for t in tables {
@@ -124,15 +124,21 @@ fn rates_table(md: &mut String, rates: &[RateRow]) {
     table(md, &header, rows);
 }
 
-/// Diverged and failed runs are left out of fits and figures; this says which and why.
-fn unfinished(md: &mut String, runs: &[&RunSummary]) {
+/// Diverged and failed runs are left out of fits and convergence figures; this says which
+/// and why.
+fn unfinished(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
     let bad: Vec<&&RunSummary> = runs.iter().filter(|r| r.status != RunStatus::Ok).collect();
     if bad.is_empty() {
         return;
     }
-    md.push_str(
-        "## Diverged and failed runs\n\nThese runs are left out of the rates and figures.\n\n",
-    );
+    let studies_stability = experiment.figures.iter().any(|f| f.stability.is_some())
+        || experiment.tables.iter().any(|t| t.stability.is_some());
+    md.push_str(if studies_stability {
+        "## Diverged and failed runs\n\nThese runs are left out of the rates and convergence \
+         figures; the stability figures and tables count a diverged run as unstable.\n\n"
+    } else {
+        "## Diverged and failed runs\n\nThese runs are left out of the rates and figures.\n\n"
+    });
     let header = ["run", "axes", "status", "message"].map(String::from);
     let rows = bad.iter().map(|run| {
         vec![

@@ -12,6 +12,7 @@ mod group;
 mod markdown;
 mod plot;
 mod pointwise;
+pub mod stability;
 mod tables;
 
 use std::fs;

@@ -1,5 +1,5 @@
-//! Draws a figure to PNG with plotters: log-log convergence plots and linear plots of
-//! reconstructed functions. Text uses the embedded DejaVu font, so rendering needs no system
+//! Draws a figure to PNG with plotters: log-log convergence plots, linear plots of
+//! reconstructed functions and stability limits, and log-linear error histories. Text uses the embedded DejaVu font, so rendering needs no system
 //! fonts and gives the same bytes on every machine.
 
 use std::io;
@@ -114,6 +114,21 @@ fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
                 builder.build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
             let x_label = |v: &f64| linear_tick_label(*v, x_range);
             let y_label = |v: &f64| linear_tick_label(*v, y_range);
+            draw_series(chart, figure, &x_label, &y_label)
+        }
+        Scale::LogY => {
+            let x_range = padded_linear_range(xs);
+            let (y_lo, y_hi) = padded_log_range(ys);
+            let (y_major, y_minor) = log_ticks(y_lo, y_hi);
+            let chart = builder.build_cartesian_2d(
+                x_range.0..x_range.1,
+                (y_lo..y_hi)
+                    .log_scale()
+                    .with_key_points(y_major)
+                    .with_light_points(y_minor),
+            )?;
+            let x_label = |v: &f64| linear_tick_label(*v, x_range);
+            let y_label = |v: &f64| tick_label(*v);
             draw_series(chart, figure, &x_label, &y_label)
         }
     }

@@ -1,9 +1,11 @@
-//! The tables of pointwise values that reconstruction experiments ask for: u - u^h at the
-//! nodes in Gong's format (Tables 4.1-4.2) and the <p_i, p_i> of the orthogonal basis
-//! (Tran Figs 1-3). They go into report.md; the numbers come from the run files unchanged.
+//! The tables that experiments ask for: u - u^h at the nodes in Gong's format (Tables
+//! 4.1-4.2), the <p_i, p_i> of the orthogonal basis (Tran Figs 1-3), and measured stability
+//! limits (`stability`). They go into report.md; the numbers come from the run files
+//! unchanged.
 
 use super::format::general;
-use super::group::{group_runs, label, selects};
+use super::group::{group_runs, label, selects, title_suffix};
+use super::stability;
 use crate::experiment::{Experiment, TableKind, TableSpec};
 use crate::output::{ReconstructionRecord, RunSummary};
 
@@ -24,6 +26,7 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
         match spec.kind {
             TableKind::NodalErrors => tables.extend(nodal_errors(experiment, selected, spec)),
             TableKind::BasisNorms => tables.extend(basis_norms(selected)),
+            TableKind::Stability => tables.extend(stability::tables(selected, spec)),
         }
     }
     tables
@@ -60,13 +63,11 @@ fn nodal_errors<'a>(
                         row
                     })
                     .collect();
-            let within = if group.label.is_empty() {
-                String::new()
-            } else {
-                format!(": {}", group.label)
-            };
             Some(Table {
-                title: format!("u(x_i) - u^h(x_i) at the nodes{within}"),
+                title: format!(
+                    "u(x_i) - u^h(x_i) at the nodes{}",
+                    title_suffix(&group.label)
+                ),
                 note: "Four decimals as in Gong's Tables 4.1-4.2; an error below 1e-12 (rounding) \
                        is printed as 0, a node without data in reach as NaN."
                     .into(),

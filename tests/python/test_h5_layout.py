@@ -526,7 +526,7 @@ class Benchmark(NamedTuple):
     max_dt: Callable  # run -> the step the time step may not exceed
 
 
-GONG_PARAMS = ("G", "E", "nu", "cfl")
+GONG_PARAMS = ("G", "E", "nu", "cfl", "courant_limit")
 BENCHMARKS = {
     "mms1d_gong": Benchmark(1, GONG_PARAMS, lambda run: 1.0, gong_wave, gong_max_dt),
     "mms2d_gong": Benchmark(2, GONG_PARAMS, lambda run: 1.0, gong_wave, gong_max_dt),

@@ -6,7 +6,9 @@ use crate::experiment::{Experiment, FigureSpec};
 use crate::output::RunSummary;
 use crate::report::fit::{fit_loglog, min_max};
 use crate::report::format::rate;
-use crate::report::group::{group_runs, usable_points, REFINEMENT_AXIS};
+use crate::report::group::{
+    group_runs, label_or_all, title_suffix, usable_points, REFINEMENT_AXIS,
+};
 
 /// One figure per combination of the axes other than the refinement axis and `by`.
 pub(super) fn figures(
@@ -26,16 +28,8 @@ pub(super) fn figures(
             if series.is_empty() {
                 return None;
             }
-            let which = if group.label.is_empty() {
-                "all".to_string()
-            } else {
-                group.label.clone()
-            };
-            let title = if group.label.is_empty() {
-                experiment.name.clone()
-            } else {
-                format!("{}: {}", experiment.name, group.label)
-            };
+            let which = label_or_all(&group.label);
+            let title = format!("{}{}", experiment.name, title_suffix(&group.label));
             Some(Figure {
                 file: names.file(experiment, &format!("{which}_{}", spec.norm)),
                 title,

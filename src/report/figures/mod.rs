@@ -2,6 +2,7 @@
 
 mod convergence;
 mod profiles;
+mod stability;
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -17,6 +18,8 @@ pub enum Scale {
     Linear,
     /// log10 on both axes (convergence figures).
     LogLog,
+    /// Linear x, log10 y (error histories).
+    LogY,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +82,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
         norm: measures.norms[0].to_string(),
         by: None,
         select: Params::new(),
+        stability: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -100,6 +104,12 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
                 figures.extend(profiles::reconstructions(experiment, &selected, &mut names))
             }
             FigureKind::Basis => figures.extend(profiles::bases(experiment, &selected, &mut names)),
+            FigureKind::Stability => figures.extend(stability::limit_figures(
+                experiment, &selected, spec, &mut names,
+            )),
+            FigureKind::Growth => figures.extend(stability::growth_figures(
+                experiment, &selected, spec, &mut names,
+            )),
         }
     }
     figures
