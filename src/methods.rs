@@ -3,7 +3,9 @@
 
 use std::fmt;
 
-use crate::reconstruct::{Degree, Kernel, QuadratureRecipe, Recipe, Solver, Weight};
+use crate::reconstruct::{
+    Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe, Weight,
+};
 use crate::shape::DomainShape;
 
 /// Basis functions used on the background grid.
@@ -25,6 +27,10 @@ pub enum TransferKind {
     /// Mass and forces lumped as in `Shepard`, the nodal velocity a least-squares fit of the
     /// particle velocities (improved CPDI, Gong sec 6.6).
     FittedVelocity(Recipe),
+    /// Taylor least squares per element: stress fitted freely, density and momentum with the
+    /// element's mass and momentum prescribed, integrated by Gauss quadrature (Wobbes et al.
+    /// sec 3).
+    Taylor(TaylorRecipe),
 }
 
 /// How the grid equations are advanced in time.
@@ -80,6 +86,14 @@ const IMLS: QuadratureRecipe = QuadratureRecipe {
 const IMLS_EQ27: QuadratureRecipe = QuadratureRecipe {
     fields: recipe(Weight::QuadraticSpline, 2.0, Solver::Imls),
     ..IMLS
+};
+
+/// Wobbes et al. sec 5: quadratic TLS (n_b = 3 in 1D), two Gauss points per element and
+/// axis, velocity and acceleration solved with the consistent mass matrix (eqs 9-11).
+const TLS: TaylorRecipe = TaylorRecipe {
+    degree: 2,
+    gauss_points: 2,
+    mass: MassMatrix::Consistent,
 };
 
 const fn on_domains(
@@ -144,6 +158,29 @@ const PRESETS: &[MethodPreset] = &[
         },
         source: "Tran, Berzins, Solowski 2019, eq 27 as printed",
         description: "IMLS-MPM with the field weight scaled by 2h (support 3h)",
+    },
+    MethodPreset {
+        name: "mpm_tls",
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::Taylor(TLS),
+            integrator: IntegratorKind::Musl,
+        },
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+        description: "MPM with the conservative TLS mapping and the consistent mass matrix, MUSL",
+    },
+    MethodPreset {
+        name: "mpm_tls_lumped",
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::Taylor(TaylorRecipe {
+                mass: MassMatrix::Lumped,
+                ..TLS
+            }),
+            integrator: IntegratorKind::Musl,
+        },
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+        description: "MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
     },
     MethodPreset {
         name: "ugimp",
@@ -234,6 +271,7 @@ impl fmt::Display for TransferKind {
             TransferKind::Shepard => f.write_str("shepard"),
             TransferKind::Quadrature(recipe) => write!(f, "quadrature({recipe})"),
             TransferKind::FittedVelocity(recipe) => write!(f, "fitted-velocity({recipe})"),
+            TransferKind::Taylor(recipe) => write!(f, "taylor({recipe})"),
         }
     }
 }

@@ -77,12 +77,30 @@ pub struct Errors {
 /// `/conservation`: mass totals at the history samples (the times are `/history/time`).
 /// Methods that reconstruct density at quadrature points do not carry the particle mass to
 /// the grid exactly; these totals show by how much.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Conservation {
     /// Nt sums of the particle masses.
     pub particle_mass: Vec<f64>,
     /// Nt sums of the lumped nodal masses assembled at the sampled step.
     pub grid_mass: Vec<f64>,
+    /// Over every mapping of the run (each step's particle-to-grid transfer and, for MUSL, the
+    /// velocity remap): max |sum_i m_i - sum_p M_p| / sum_p M_p ...
+    pub max_mass_error: f64,
+    /// ... and max |sum_i p_i - sum_p M_p v_p| / sum_p M_p |v_p|, the momentum the DOFs received
+    /// against the particles' (absolute when every particle is at rest). NaN for runs that
+    /// did not map.
+    pub max_momentum_error: f64,
+}
+
+impl Default for Conservation {
+    fn default() -> Self {
+        Conservation {
+            particle_mass: Vec::new(),
+            grid_mass: Vec::new(),
+            max_mass_error: f64::NAN,
+            max_momentum_error: f64::NAN,
+        }
+    }
 }
 
 /// `/diagnostics`: how the local least-squares fits of a run went.

@@ -66,6 +66,12 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     ] {
         dataset(&conservation, name, values, &[nt], "kg")?;
     }
+    for (name, value) in [
+        ("max_mass_error", r.conservation.max_mass_error),
+        ("max_momentum_error", r.conservation.max_momentum_error),
+    ] {
+        attr_f64(&conservation, name, value)?;
+    }
     let diagnostics = file.create_group("diagnostics")?;
     for (name, value) in [
         ("reconstructions", r.diagnostics.reconstructions),

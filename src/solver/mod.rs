@@ -65,6 +65,14 @@ enum Basis<const D: usize> {
     Domains(ParticleDomains<D>),
 }
 
+/// The particle-to-grid mappings of a step: the transfer at its start, and MUSL's remap of
+/// the updated particle velocities.
+#[derive(Clone, Copy)]
+enum Mapping {
+    Step,
+    Remap,
+}
+
 /// The state of one run in progress.
 struct Run<'a, const D: usize> {
     spec: &'a RunSpec,
@@ -103,7 +111,7 @@ impl<'a, const D: usize> Run<'a, D> {
             spec,
             method,
             stencils: Stencils::new(per_point, n),
-            transfer: Transfer::new(&method.transfer, &grid),
+            transfer: Transfer::new(&method.transfer, &grid, &fixed),
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
@@ -154,10 +162,11 @@ impl<'a, const D: usize> Run<'a, D> {
                 Ok(stats) => self.fits += stats,
                 Err(reason) => return (s, Err((s, reason))),
             }
+            self.track_mapping(Mapping::Step);
             // Leapfrog starts with a half kick from v^0 to v^{1/2}.
             let leapfrog = self.method.integrator == IntegratorKind::Leapfrog;
             let kick = if leapfrog && s == 0 { 0.5 * dt } else { dt };
-            integrate::solve_grid(&mut self.nodes, &self.fixed, kick);
+            self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick);
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
                 let velocity = if leapfrog {
                     let half = if s == 0 { 0.0 } else { 0.5 * dt };
@@ -194,6 +203,18 @@ impl<'a, const D: usize> Run<'a, D> {
             }
         }
         (steps, Ok(()))
+    }
+
+    /// Records how far the totals the last mapping gave the DOFs are from the particles'.
+    fn track_mapping(&mut self, mapping: Mapping) {
+        let velocity = match mapping {
+            Mapping::Step => &self.nodes.velocity,
+            Mapping::Remap => &self.remapped,
+        };
+        let grid_mass = self.nodes.mass.iter().sum();
+        let momentum = self.transfer.received_momentum(&self.nodes.mass, velocity);
+        self.recorder
+            .track_mapping(&self.particles, grid_mass, &momentum);
     }
 
     /// The shape functions of every particle at its current position and domain.
@@ -233,6 +254,7 @@ impl<'a, const D: usize> Run<'a, D> {
                     &self.nodes,
                     &mut self.remapped,
                 );
+                self.track_mapping(Mapping::Remap);
                 integrate::apply_fixed(&mut self.remapped, &self.fixed);
                 musl::deform_particles(
                     &self.stencils,

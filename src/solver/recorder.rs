@@ -50,6 +50,30 @@ impl Recorder {
         self.conservation.grid_mass.push(grid_mass);
     }
 
+    /// Compares the totals a mapping gave the grid with the particles' totals it started
+    /// from and keeps the largest relative errors of the run.
+    pub fn track_mapping<const D: usize>(
+        &mut self,
+        particles: &Particles<D>,
+        grid_mass: f64,
+        grid_momentum: &SVector<f64, D>,
+    ) {
+        let mut mass = 0.0;
+        let mut momentum = SVector::<f64, D>::zeros();
+        let mut scale = 0.0;
+        for (m, v) in particles.mass.iter().zip(&particles.v) {
+            mass += m;
+            momentum += v * *m;
+            scale += m * v.norm();
+        }
+        let mass_error = (grid_mass - mass).abs() / mass;
+        let momentum_error =
+            (grid_momentum - momentum).norm() / if scale > 0.0 { scale } else { 1.0 };
+        let c = &mut self.conservation;
+        c.max_mass_error = nan_max(c.max_mass_error, mass_error);
+        c.max_momentum_error = nan_max(c.max_momentum_error, momentum_error);
+    }
+
     fn sample_errors<const D: usize>(
         &mut self,
         t: f64,
@@ -87,5 +111,15 @@ impl Recorder {
             e.l2[f].push(sum_v[f].sqrt());
             e.rms[f].push((sum_n[f] / n).sqrt());
         }
+    }
+}
+
+/// The larger of the two; `current` is NaN until something was tracked, and a NaN `value`
+/// is kept rather than hidden.
+fn nan_max(current: f64, value: f64) -> f64 {
+    if value <= current {
+        current
+    } else {
+        value
     }
 }

@@ -2,24 +2,26 @@
 
 use nalgebra::SVector;
 
-use crate::integrate::Divergence;
+use crate::integrate::{self, Divergence, FixedDof};
 use crate::methods::TransferKind;
 use crate::particles::Particles;
 use crate::reconstruct::{
     particles_to_grid, remap_velocity, FitStats, GridState, Lattice, QuadratureTransfer,
-    Reconstructor,
+    Reconstructor, TaylorTransfer,
 };
-use crate::shape::{Grid, Stencils};
+use crate::shape::{Grid, LinearHat, Stencils};
 
 pub enum Transfer<const D: usize> {
     Shepard,
     Quadrature(Box<QuadratureTransfer<D>>),
     /// The Shepard transfer with the nodal velocity replaced by this fit at the nodes.
     FittedVelocity(Box<Reconstructor<D>>),
+    /// Taylor least squares per element with its own mass matrix.
+    Taylor(Box<TaylorTransfer<D>>),
 }
 
 impl<const D: usize> Transfer<D> {
-    pub fn new(kind: &TransferKind, grid: &Grid<D>) -> Self {
+    pub fn new(kind: &TransferKind, grid: &Grid<D>, fixed: &[FixedDof]) -> Self {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
             TransferKind::Quadrature(recipe) => {
@@ -28,6 +30,13 @@ impl<const D: usize> Transfer<D> {
             TransferKind::FittedVelocity(recipe) => Transfer::FittedVelocity(Box::new(
                 Reconstructor::new(*recipe, Lattice::nodes(grid)),
             )),
+            TransferKind::Taylor(recipe) => Transfer::Taylor(Box::new(TaylorTransfer::new(
+                *recipe,
+                grid,
+                &LinearHat,
+                grid.num_nodes(),
+                fixed,
+            ))),
         }
     }
 
@@ -55,13 +64,32 @@ impl<const D: usize> Transfer<D> {
                 fit.apply(&particles.v, &mut grid.velocity);
                 Ok(stats)
             }
+            Transfer::Taylor(tls) => tls.map_to_grid(stencils, particles, body_force, grid),
+        }
+    }
+
+    /// The grid solve (a = M^-1 f, v_new = v + kick a) with the transfer's mass matrix.
+    pub fn solve_grid(&mut self, grid: &mut GridState<D>, fixed: &[FixedDof], kick: f64) {
+        match self {
+            Transfer::Taylor(tls) => tls.solve_grid(grid, kick),
+            _ => integrate::solve_grid(grid, fixed, kick),
+        }
+    }
+
+    /// Total momentum the DOFs received from the last mapping (`grid` after `map_to_grid`,
+    /// or the remapped velocity `velocity`): sum_i p_i, before boundary conditions where the
+    /// transfer assembles p; sum_i m_i v_i otherwise.
+    pub fn received_momentum(&self, mass: &[f64], velocity: &[SVector<f64, D>]) -> SVector<f64, D> {
+        match self {
+            Transfer::Taylor(tls) => tls.momentum_total(),
+            _ => mass.iter().zip(velocity).map(|(&m, v)| v * m).sum(),
         }
     }
 
     /// The nodal velocity rebuilt from the particle velocities `v` with this step's
     /// weights (MUSL's v_i^L): mass-weighted for Shepard, the velocity fit otherwise.
     pub fn remap_velocity(
-        &self,
+        &mut self,
         stencils: &Stencils<D>,
         particles: &Particles<D>,
         grid: &GridState<D>,
@@ -71,6 +99,7 @@ impl<const D: usize> Transfer<D> {
             Transfer::Shepard => remap_velocity(stencils, particles, grid, out),
             Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
             Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
+            Transfer::Taylor(tls) => tls.remap_velocity(particles, grid, out),
         }
     }
 }

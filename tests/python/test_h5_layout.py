@@ -53,6 +53,8 @@ FIELDS = ("displacement", "velocity", "stress", "density")
 NORMS = ("l2", "rms")
 
 MASS_UNITS = "kg"
+# Methods whose mappings conserve mass and momentum to round-off.
+CONSERVATIVE_METHODS = ("mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped")
 DIAGNOSTICS = ("reconstructions", "rank_deficient")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
@@ -415,6 +417,19 @@ def test_conservation(run):
         np.testing.assert_allclose(
             grid, particle, rtol=1e-12, atol=0, err_msg="mpm grid mass != particle mass"
         )
+    # The largest relative mass and momentum errors of any mapping of the run. Methods that
+    # conserve both (lumped Shepard mappings and TLS) must stay within a summation bound:
+    # a few rounding errors per particle and DOF.
+    errors = run.group("/conservation")
+    for name in ("max_mass_error", "max_momentum_error"):
+        assert name in errors, f"/conservation has no attribute {name}"
+        if run.status == "ok":
+            assert np.isfinite(errors[name]) and errors[name] >= 0, f"{name} = {errors[name]}"
+    if run.status == "ok" and run.attrs["method"] in CONSERVATIVE_METHODS:
+        dofs = (int(run.attrs["cells"]) + 3) ** int(run.attrs["dim"])
+        bound = 4 * np.finfo(float).eps * (len(run.ds("/particles/mass")) + dofs)
+        for name in ("max_mass_error", "max_momentum_error"):
+            assert errors[name] <= bound, f"{name} = {errors[name]:.3e} > {bound:.3e}"
 
 
 def test_diagnostics(run):
