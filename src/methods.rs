@@ -15,6 +15,12 @@ pub enum ShapeKind {
     Linear,
     /// The hat averaged over each particle's domain (GIMP, CPDI; Gong ch. 6).
     Domain(DomainShape),
+    /// Quadratic B-splines on the open knot vector 0, 0, 0, h, ..., L, L, L (tensor product
+    /// in 2D): cells + 2 DOFs per axis (BSMPM; Steffen et al. 2008, Tielen et al. 2017).
+    QuadraticBSpline,
+    /// The hat's values with the dual-domain gradient, the hat's gradient averaged over the
+    /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011).
+    DualDomain,
 }
 
 /// How particle data reaches the grid.
@@ -105,6 +111,14 @@ const fn on_domains(
         shape: ShapeKind::Domain(shape),
         transfer,
         integrator,
+    }
+}
+
+const fn musl_on(shape: ShapeKind) -> Method {
+    Method {
+        shape,
+        transfer: TransferKind::Shepard,
+        integrator: IntegratorKind::Musl,
     }
 }
 
@@ -242,6 +256,18 @@ const PRESETS: &[MethodPreset] = &[
         source: "Gong 2015, sec 6.6 (improved CPDI)",
         description: "CPDI2 with IMPM's MLS velocity at the nodes (cubic spline), leapfrog",
     },
+    MethodPreset {
+        name: "bsmpm",
+        method: musl_on(ShapeKind::QuadraticBSpline),
+        source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
+        description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
+    },
+    MethodPreset {
+        name: "ddmpm",
+        method: musl_on(ShapeKind::DualDomain),
+        source: "Zhang, Ma & Giguere 2011; Wobbes et al. 2018",
+        description: "dual-domain MPM: hat values, node-averaged gradient, lumped mass, MUSL",
+    },
 ];
 
 pub fn presets() -> &'static [MethodPreset] {
@@ -261,6 +287,8 @@ impl fmt::Display for ShapeKind {
         match self {
             ShapeKind::Linear => f.write_str("linear"),
             ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
+            ShapeKind::QuadraticBSpline => f.write_str("quadratic-bspline"),
+            ShapeKind::DualDomain => f.write_str("dual-domain"),
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use crate::shape::{lattice_strides, Grid};
+use crate::shape::{lattice_strides, Dofs, Grid};
 
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
@@ -30,8 +30,9 @@ impl<const D: usize> Lattice<D> {
         }
     }
 
-    /// The grid nodes, numbered as the grid numbers them.
+    /// The grid nodes, numbered as the grid numbers them (a grid of `Dofs::Nodes`).
     pub fn nodes(grid: &Grid<D>) -> Self {
+        debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         Self::new(grid, vec![0.0], grid.cells + 1)
     }
 

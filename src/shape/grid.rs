@@ -2,40 +2,81 @@ use nalgebra::SVector;
 
 use crate::benchmarks::Domain;
 
-/// A uniform background grid: `cells` cells of size `h` per direction, nodes numbered
-/// with the first axis fastest.
+/// Where the degrees of freedom of the grid's basis sit along each axis. The grid's "nodes"
+/// are these DOFs: nodal masses, velocities and forces live on them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dofs {
+    /// One per grid node, cells + 1 per axis: the hat and the shapes built on it.
+    Nodes,
+    /// The quadratic B-spline on the open knot vector 0, 0, 0, h, 2h, ..., L, L, L:
+    /// cells + 2 per axis, at the Greville abscissae 0, h/2, 3h/2, ..., L - h/2, L.
+    QuadraticSpline,
+}
+
+/// A uniform background grid: `cells` cells of size `h` per direction, and the DOFs of its
+/// basis ("nodes") numbered with the first axis fastest.
 #[derive(Clone, Debug)]
 pub struct Grid<const D: usize> {
     pub lower: SVector<f64, D>,
     pub h: f64,
     pub cells: usize,
+    dofs: Dofs,
     inv_h: f64,
+    per_axis: usize,
     strides: [usize; D],
     num_nodes: usize,
 }
 
 impl<const D: usize> Grid<D> {
-    /// A grid over `domain`; the domain must be a cube (the same h in every direction).
+    /// A grid with one DOF per node over `domain`; the domain must be a cube (the same h in
+    /// every direction).
     pub fn new(domain: &Domain<D>) -> Self {
+        Self::with_dofs(domain, Dofs::Nodes)
+    }
+
+    /// A grid over `domain` whose basis has the DOFs `dofs`.
+    pub fn with_dofs(domain: &Domain<D>, dofs: Dofs) -> Self {
         let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
-        let n = domain.cells + 1;
+        let n = match dofs {
+            Dofs::Nodes => domain.cells + 1,
+            Dofs::QuadraticSpline => domain.cells + 2,
+        };
         let strides = lattice_strides(&[n; D]);
         Grid {
             lower: domain.lower,
             h,
             cells: domain.cells,
+            dofs,
             inv_h: 1.0 / h,
+            per_axis: n,
             strides,
             num_nodes: n.pow(D as u32),
         }
     }
 
+    pub fn dofs(&self) -> Dofs {
+        self.dofs
+    }
+
+    /// The number of DOFs (nodes) of the grid's basis.
     pub fn num_nodes(&self) -> usize {
         self.num_nodes
     }
 
+    /// DOFs (nodes) per axis: cells + 1 for the hat, cells + 2 for the quadratic B-spline.
     pub fn nodes_per_dim(&self) -> usize {
-        self.cells + 1
+        self.per_axis
+    }
+
+    /// Position of DOF `i` along one axis: the grid node, or the Greville abscissa of the
+    /// B-spline (the mean of its interior knots), where it carries the value of a linear
+    /// function that the basis reproduces.
+    pub fn dof_coordinate(&self, axis: usize, i: usize) -> f64 {
+        let in_cells = match self.dofs {
+            Dofs::Nodes => i as f64,
+            Dofs::QuadraticSpline => (i as f64 - 0.5).clamp(0.0, self.cells as f64),
+        };
+        self.lower[axis] + in_cells * self.h
     }
 
     /// Flat index of the node with integer coordinates `ijk`.
@@ -50,10 +91,10 @@ impl<const D: usize> Grid<D> {
         std::array::from_fn(|k| (index / self.strides[k]) % n)
     }
 
-    /// Position of the node with flat index `index`.
+    /// Position of the node (DOF) with flat index `index`.
     pub fn node_position(&self, index: usize) -> SVector<f64, D> {
         let ijk = self.node_coords(index);
-        SVector::from_fn(|k, _| self.lower[k] + ijk[k] as f64 * self.h)
+        SVector::from_fn(|k, _| self.dof_coordinate(k, ijk[k]))
     }
 
     /// The cell containing `x` and the local coordinates in [0, 1] within it, or `None`

@@ -1,8 +1,10 @@
 use nalgebra::SVector;
 
-use super::{Grid, Shape};
+use super::{Dofs, Grid, Shape};
 
-/// The piecewise-linear hat of Gong eq 4.8, a tensor product in 2D: 2^D nodes per point.
+/// The piecewise-linear hat of Gong eq 4.8, a tensor product in 2D: 2^D nodes per point, the
+/// corners of the point's cell, entry `corner` with bit k set for the upper node along axis k.
+/// It lives on a grid of `Dofs::Nodes`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct LinearHat;
 
@@ -20,6 +22,7 @@ impl<const D: usize> Shape<D> for LinearHat {
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
     ) -> bool {
+        debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         let Some((cell, xi)) = grid.locate(x) else {
             return false;
         };

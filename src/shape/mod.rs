@@ -1,14 +1,19 @@
 //! Basis functions on the background grid and the per-particle tables of their values.
 
+mod block;
+mod bspline;
 mod domain;
+mod dual_domain;
 mod grid;
 mod linear;
 mod stencils;
 
 use nalgebra::SVector;
 
+pub use bspline::QuadraticBSpline;
 pub use domain::{DomainFault, DomainShape, ParticleDomains};
-pub use grid::{lattice_coords, lattice_strides, Grid};
+pub use dual_domain::DualDomain;
+pub use grid::{lattice_coords, lattice_strides, Dofs, Grid};
 pub use linear::LinearHat;
 pub use stencils::Stencils;
 

@@ -16,7 +16,9 @@ use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
 use crate::reconstruct::{FitStats, GridState};
-use crate::shape::{Grid, LinearHat, ParticleDomains, Shape, Stencils};
+use crate::shape::{
+    Dofs, DualDomain, Grid, LinearHat, ParticleDomains, QuadraticBSpline, Shape, Stencils,
+};
 
 use recorder::Recorder;
 use transfer::Transfer;
@@ -63,6 +65,10 @@ enum Basis<const D: usize> {
     Hat,
     /// The hat averaged over each particle's domain.
     Domains(ParticleDomains<D>),
+    /// The quadratic B-spline evaluated at x_p.
+    BSpline,
+    /// The hat with the dual-domain gradient, from the integrals over this step's material.
+    DualDomain(DualDomain<D>),
 }
 
 /// The particle-to-grid mappings of a step: the transfer at its start, and MUSL's remap of
@@ -94,7 +100,11 @@ struct Run<'a, const D: usize> {
 
 impl<'a, const D: usize> Run<'a, D> {
     fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>) -> Self {
-        let grid = Grid::new(&problem.domain());
+        let dofs = match method.shape {
+            ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
+            ShapeKind::Linear | ShapeKind::Domain(_) | ShapeKind::DualDomain => Dofs::Nodes,
+        };
+        let grid = Grid::with_dofs(&problem.domain(), dofs);
         let particles = Particles::seed(problem.as_ref(), &grid);
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
@@ -106,6 +116,15 @@ impl<'a, const D: usize> Run<'a, D> {
                 Basis::Domains(ParticleDomains::new(shape, &particles)),
                 ParticleDomains::<D>::nodes_per_point(),
             ),
+            ShapeKind::QuadraticBSpline => (
+                Basis::BSpline,
+                Shape::<D>::nodes_per_point(&QuadraticBSpline),
+            ),
+            ShapeKind::DualDomain => {
+                let dual = DualDomain::new(&grid);
+                let per_point = dual.nodes_per_point();
+                (Basis::DualDomain(dual), per_point)
+            }
         };
         Run {
             spec,
@@ -219,7 +238,7 @@ impl<'a, const D: usize> Run<'a, D> {
 
     /// The shape functions of every particle at its current position and domain.
     fn update_stencils(&mut self) -> Result<(), Divergence> {
-        match &self.basis {
+        match &mut self.basis {
             Basis::Hat => self
                 .stencils
                 .update(&LinearHat, &self.grid, &self.particles.x)
@@ -228,6 +247,14 @@ impl<'a, const D: usize> Run<'a, D> {
                 domains.fill(&self.grid, &mut self.particles, &mut self.stencils)?;
                 Ok(())
             }
+            Basis::BSpline => self
+                .stencils
+                .update(&QuadraticBSpline, &self.grid, &self.particles.x)
+                .map_err(|particle| Divergence::LeftGrid { particle }),
+            Basis::DualDomain(dual) => dual
+                .integrate(&self.grid, &self.particles.x, &self.particles.volume)
+                .and_then(|()| self.stencils.update(dual, &self.grid, &self.particles.x))
+                .map_err(|particle| Divergence::LeftGrid { particle }),
         }
     }
 
@@ -297,14 +324,18 @@ impl<'a, const D: usize> Run<'a, D> {
     }
 }
 
-/// The velocity components held at zero: the normal component on each fixed face.
+/// The velocity components held at zero: the normal component of the DOFs on each fixed
+/// face. Every basis interpolates at the faces (the hat at its nodes, the clamped B-spline at
+/// its end DOFs: on a face only the DOFs there are nonzero, and they sum to one), so this
+/// holds the normal velocity of the whole face at zero.
 fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<FixedDof> {
+    let last = grid.nodes_per_dim() - 1;
     let mut fixed = Vec::new();
     for i in 0..grid.num_nodes() {
         let ijk = grid.node_coords(i);
         for k in 0..D {
             let on_lower = faces[k][0] && ijk[k] == 0;
-            let on_upper = faces[k][1] && ijk[k] == grid.cells;
+            let on_upper = faces[k][1] && ijk[k] == last;
             if on_lower || on_upper {
                 fixed.push((i as u32, k as u8));
             }

@@ -14,6 +14,7 @@ use std::fmt;
 
 use nalgebra::SVector;
 
+use super::block::{block_node, block_start, NODES_PER_AXIS};
 use super::{lattice_coords, lattice_strides, Grid, LinearHat, Shape, Stencils};
 use crate::particles::Particles;
 use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
@@ -48,9 +49,6 @@ impl fmt::Display for DomainShape {
         f.write_str(self.name())
     }
 }
-
-/// Nodes per axis in a stencil: a domain may span up to three cells.
-pub const NODES_PER_AXIS: usize = 4;
 
 /// Why the stencils of a particle could not be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -223,39 +221,6 @@ impl<const D: usize> ParticleDomains<D> {
 fn clamp_to_grid<const D: usize>(grid: &Grid<D>, x: &SVector<f64, D>) -> SVector<f64, D> {
     let upper = grid.cells as f64 * grid.h;
     SVector::from_fn(|k, _| x[k].clamp(grid.lower[k], grid.lower[k] + upper))
-}
-
-/// The first node of the stencil block along each axis for a bounding box [lo, hi] (in cell
-/// units from the grid's lower corner), or `None` when the box spans more cells than a block.
-fn block_start<const D: usize>(
-    grid: &Grid<D>,
-    lo: &SVector<f64, D>,
-    hi: &SVector<f64, D>,
-) -> Option<[usize; D]> {
-    let last_start = grid.cells.saturating_sub(NODES_PER_AXIS - 1);
-    let mut start = [0; D];
-    for k in 0..D {
-        start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
-        if hi[k] > (start[k] + NODES_PER_AXIS - 1) as f64 {
-            return None;
-        }
-    }
-    Some(start)
-}
-
-/// Node index of entry `e` of a stencil block starting at `start`: the block's first axis
-/// runs fastest. Entries past the grid (grids with fewer than three cells) repeat the last node
-/// with zero weight.
-fn block_node<const D: usize>(grid: &Grid<D>, start: &[usize; D], e: usize) -> (usize, [usize; D]) {
-    let mut index = 0;
-    let mut local = [0; D];
-    let mut rest = e;
-    for k in 0..D {
-        local[k] = rest % NODES_PER_AXIS;
-        rest /= NODES_PER_AXIS;
-        index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
-    }
-    (index, local)
 }
 
 /// GIMP: the box [x - half, x + half], cut to the grid, as a product of per-axis averages.

@@ -1,0 +1,59 @@
+//! Stencils over a block of `NODES_PER_AXIS` grid nodes per axis, shared by the shapes whose
+//! support at a point is wider than one cell (particle domains, the dual-domain gradient).
+
+use nalgebra::SVector;
+
+use super::Grid;
+
+/// Nodes per axis in a block stencil: a particle domain may span up to three cells, and the
+/// dual-domain gradient reaches one node beyond the point's cell on each side.
+pub const NODES_PER_AXIS: usize = 4;
+
+/// The first block start along each axis that keeps the block inside the grid.
+fn last_start<const D: usize>(grid: &Grid<D>) -> usize {
+    grid.cells.saturating_sub(NODES_PER_AXIS - 1)
+}
+
+/// The first node of the stencil block along each axis for a bounding box [lo, hi] (in cell
+/// units from the grid's lower corner), or `None` when the box spans more cells than a block.
+pub fn block_start<const D: usize>(
+    grid: &Grid<D>,
+    lo: &SVector<f64, D>,
+    hi: &SVector<f64, D>,
+) -> Option<[usize; D]> {
+    let last_start = last_start(grid);
+    let mut start = [0; D];
+    for k in 0..D {
+        start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
+        if hi[k] > (start[k] + NODES_PER_AXIS - 1) as f64 {
+            return None;
+        }
+    }
+    Some(start)
+}
+
+/// The first node of the block around `cell`: its nodes and one more on each side, the block
+/// shifted inwards where the grid ends.
+pub fn block_around_cell<const D: usize>(grid: &Grid<D>, cell: &[usize; D]) -> [usize; D] {
+    let last_start = last_start(grid);
+    std::array::from_fn(|k| cell[k].saturating_sub(1).min(last_start))
+}
+
+/// Node index of entry `e` of a stencil block starting at `start`: the block's first axis
+/// runs fastest. Entries past the grid (grids with fewer than three cells) repeat the last node
+/// and must carry zero weight.
+pub fn block_node<const D: usize>(
+    grid: &Grid<D>,
+    start: &[usize; D],
+    e: usize,
+) -> (usize, [usize; D]) {
+    let mut index = 0;
+    let mut local = [0; D];
+    let mut rest = e;
+    for k in 0..D {
+        local[k] = rest % NODES_PER_AXIS;
+        rest /= NODES_PER_AXIS;
+        index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
+    }
+    (index, local)
+}

@@ -1,0 +1,360 @@
+//! The modified gradient of the dual-domain MPM (DDMPM; Zhang, Ma & Giguere 2011), as Wobbes
+//! et al. (2018) use it: the values are the hat's, S_i(x) = N_i(x), and the gradient is the
+//! node average
+//!     grad S~_i(x) = sum_j S_j(x) (int grad S_i S_j) / (int S_j),
+//! with both integrals over the material, evaluated by particle quadrature.
+
+use nalgebra::SVector;
+
+use super::block::{block_around_cell, block_node, NODES_PER_AXIS};
+use super::{Dofs, Grid, LinearHat, Shape};
+
+/// Offsets i - j per axis of the nodes i whose hat overlaps that of node j: -1, 0, 1.
+const NEIGHBOURS_PER_AXIS: usize = 3;
+
+/// Hat corners of a cell in at most two dimensions.
+const MAX_CORNERS: usize = 4;
+
+/// The nodal integrals of one step, and through them the modified basis at any point.
+///
+/// The integrals are sums over the particles, int f ~ sum_p f(x_p) V_p with the current
+/// volumes, so the dual domain of node j is the material under its hat: a cell that the
+/// material fills only in part contributes only the part it fills, and a node whose hat
+/// covers no material (int S_j = 0) has no average; it is dropped from the sum over j (see
+/// `eval`).
+pub struct DualDomain<const D: usize> {
+    /// int S_j per node j.
+    volume: Vec<f64>,
+    /// Per node j (slowest), then per offset i - j in {-1, 0, 1}^D (first axis fastest):
+    /// the average (int grad S_i S_j) / (int S_j) of grad S_i over the dual domain of j;
+    /// zero when int S_j = 0.
+    average: Vec<SVector<f64, D>>,
+}
+
+impl<const D: usize> DualDomain<D> {
+    /// Empty integrals on a grid of hat nodes.
+    pub fn new(grid: &Grid<D>) -> Self {
+        debug_assert_eq!(grid.dofs(), Dofs::Nodes);
+        let n = grid.num_nodes();
+        DualDomain {
+            volume: vec![0.0; n],
+            average: vec![SVector::zeros(); n * Self::neighbours()],
+        }
+    }
+
+    fn neighbours() -> usize {
+        NEIGHBOURS_PER_AXIS.pow(D as u32)
+    }
+
+    /// The integrals over the material of this step, from the points `positions` with
+    /// volumes `volumes` (particles in order, then the hat's corners: a fixed summation
+    /// order). On failure returns the index of the first point outside the grid.
+    pub fn integrate(
+        &mut self,
+        grid: &Grid<D>,
+        positions: &[SVector<f64, D>],
+        volumes: &[f64],
+    ) -> Result<(), usize> {
+        let corners = 1 << D;
+        let stride = Self::neighbours();
+        let mut node = [0u32; MAX_CORNERS];
+        let mut weight = [0.0; MAX_CORNERS];
+        let mut grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        self.volume.fill(0.0);
+        self.average.fill(SVector::zeros());
+        for (p, (x, &v)) in positions.iter().zip(volumes).enumerate() {
+            let (node, weight, grad) = (
+                &mut node[..corners],
+                &mut weight[..corners],
+                &mut grad[..corners],
+            );
+            if !LinearHat.eval(grid, x, node, weight, grad) {
+                return Err(p);
+            }
+            for b in 0..corners {
+                let j = node[b] as usize;
+                let sv = weight[b] * v;
+                self.volume[j] += sv;
+                for a in 0..corners {
+                    let offset = corner_offset::<D>(a, b);
+                    self.average[j * stride + offset] += grad[a] * sv;
+                }
+            }
+        }
+        for (j, &volume) in self.volume.iter().enumerate() {
+            let scale = if volume > 0.0 { 1.0 / volume } else { 0.0 };
+            for g in &mut self.average[j * stride..(j + 1) * stride] {
+                *g *= scale;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Index in {-1, 0, 1}^D (first axis fastest) of the offset from hat corner `b` of a cell to
+/// corner `a` (bit k of a corner is set for the upper node along axis k, as in `LinearHat`).
+#[inline]
+fn corner_offset<const D: usize>(a: usize, b: usize) -> usize {
+    let mut offset = 0;
+    let mut place = 1;
+    for k in 0..D {
+        offset += (1 + (a >> k & 1) - (b >> k & 1)) * place;
+        place *= NEIGHBOURS_PER_AXIS;
+    }
+    offset
+}
+
+/// The modified basis at any point of the grid from the integrals of the last `integrate`:
+/// the hat's values and grad S~_i(x) = sum_j S_j(x) (int grad S_i S_j) / (int S_j) over the
+/// corners j of x's cell. The nodes i are the block of 4 per axis around the cell (shifted
+/// inwards at the grid ends), which holds every node whose hat overlaps a corner's; entries
+/// of nodes that do not reach x carry zero. A corner with int S_j = 0 (no material under
+/// its hat) contributes nothing: where that happens the gradient loses linear consistency,
+/// sum_i x_i (x) grad S~_i = (sum of S_j(x) over the corners with material) I, and at the
+/// particles themselves it cannot happen, since every corner with S_j(x_p) > 0 has at least
+/// particle p's share. sum_i grad S~_i = 0 at every point.
+///
+/// This evaluates the run's basis at arbitrary points, e.g. the Gauss points of a quadrature
+/// transfer, through `Stencils::update`.
+impl<const D: usize> Shape<D> for DualDomain<D> {
+    fn nodes_per_point(&self) -> usize {
+        NODES_PER_AXIS.pow(D as u32)
+    }
+
+    fn eval(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> bool {
+        let corners = 1 << D;
+        let mut hat_node = [0u32; MAX_CORNERS];
+        let mut hat = [0.0; MAX_CORNERS];
+        let mut hat_grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        let Some((cell, _)) = grid.locate(x) else {
+            return false;
+        };
+        if !LinearHat.eval(
+            grid,
+            x,
+            &mut hat_node[..corners],
+            &mut hat[..corners],
+            &mut hat_grad[..corners],
+        ) {
+            return false;
+        }
+        let start = block_around_cell(grid, &cell);
+        for e in 0..node.len() {
+            node[e] = block_node(grid, &start, e).0 as u32;
+        }
+        weight.fill(0.0);
+        grad.fill(SVector::zeros());
+        let stride = DualDomain::<D>::neighbours();
+        for b in 0..corners {
+            let j = hat_node[b] as usize;
+            let corner: [usize; D] = std::array::from_fn(|k| cell[k] + (b >> k & 1));
+            weight[block_entry(&start, &corner)] = hat[b];
+            'offsets: for offset in 0..stride {
+                let mut target = corner;
+                let mut rest = offset;
+                for t in target.iter_mut() {
+                    let d = rest % NEIGHBOURS_PER_AXIS;
+                    rest /= NEIGHBOURS_PER_AXIS;
+                    // Node j - 1 does not exist at the lower end, j + 1 not at the upper.
+                    if *t + d < 1 || *t + d > grid.cells + 1 {
+                        continue 'offsets;
+                    }
+                    *t = *t + d - 1;
+                }
+                grad[block_entry(&start, &target)] += self.average[j * stride + offset] * hat[b];
+            }
+        }
+        true
+    }
+}
+
+/// Entry of node `ijk` in the block starting at `start` (first axis fastest).
+#[inline]
+fn block_entry<const D: usize>(start: &[usize; D], ijk: &[usize; D]) -> usize {
+    let mut entry = 0;
+    let mut place = 1;
+    for k in 0..D {
+        entry += (ijk[k] - start[k]) * place;
+        place *= NODES_PER_AXIS;
+    }
+    entry
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::SMatrix;
+
+    use super::*;
+    use crate::benchmarks::Domain;
+    use crate::rng::Lcg;
+    use crate::shape::lattice_coords;
+
+    fn grid<const D: usize>(cells: usize) -> Grid<D> {
+        Grid::new(&Domain {
+            lower: SVector::zeros(),
+            upper: SVector::repeat(1.0),
+            cells,
+        })
+    }
+
+    /// The modified basis at `x`: (node, S_i, grad S~_i) of every stencil entry.
+    fn basis_at<const D: usize>(
+        dual: &DualDomain<D>,
+        g: &Grid<D>,
+        x: &SVector<f64, D>,
+    ) -> Vec<(usize, f64, SVector<f64, D>)> {
+        let n = dual.nodes_per_point();
+        let (mut node, mut weight, mut grad) =
+            (vec![0; n], vec![0.0; n], vec![SVector::zeros(); n]);
+        assert!(dual.eval(g, x, &mut node, &mut weight, &mut grad));
+        (0..n)
+            .map(|e| (node[e] as usize, weight[e], grad[e]))
+            .collect()
+    }
+
+    /// Material in [0, 0.62]^D only (the cells at 0.62 partly filled), at random points with
+    /// random volumes. Where every corner of the point's cell has material, sum_i grad S~_i = 0
+    /// and sum_i x_i (x) grad S~_i = I; where some has none, the second is the sum of the
+    /// corners' S_j that have material, times I.
+    fn check_consistency<const D: usize>() {
+        let g = grid::<D>(6);
+        let mut rng = Lcg::new(2011);
+        let positions: Vec<SVector<f64, D>> = (0..300 * D)
+            .map(|_| SVector::from_fn(|_, _| 0.62 * rng.unit()))
+            .collect();
+        let volumes: Vec<f64> = positions
+            .iter()
+            .map(|_| 1e-3 * (0.5 + rng.unit()))
+            .collect();
+        let mut dual = DualDomain::new(&g);
+        dual.integrate(&g, &positions, &volumes).unwrap();
+        let (mut filled, mut partial) = (0, 0);
+        let points = (0..500).map(|_| SVector::from_fn(|_, _| rng.unit()));
+        for x in positions.iter().copied().chain(points) {
+            let entries = basis_at(&dual, &g, &x);
+            let sum_w: f64 = entries.iter().map(|e| e.1).sum();
+            let sum_g: SVector<f64, D> = entries.iter().map(|e| e.2).sum();
+            let sum_gx: SMatrix<f64, D, D> = entries
+                .iter()
+                .map(|(i, _, gr)| g.node_position(*i) * gr.transpose())
+                .sum();
+            let with_material: f64 = entries
+                .iter()
+                .filter(|(i, w, _)| *w > 0.0 && dual.volume[*i] > 0.0)
+                .map(|e| e.1)
+                .sum();
+            if (with_material - 1.0).abs() < 1e-14 {
+                filled += 1;
+            } else {
+                partial += 1;
+            }
+            let identity = SMatrix::<f64, D, D>::identity();
+            assert!((sum_w - 1.0).abs() < 1e-14);
+            assert!(sum_g.norm() < 1e-11, "{x:?}: sum grad = {sum_g:?}");
+            assert!(
+                (sum_gx - identity * with_material).norm() < 1e-12,
+                "{x:?}: sum x (x) grad = {sum_gx:?}, corners with material {with_material}"
+            );
+        }
+        assert!(
+            filled > 300 * D && partial > 100,
+            "{filled} filled, {partial} partial"
+        );
+    }
+
+    #[test]
+    fn dual_domain_gradient_is_consistent_where_there_is_material_1d() {
+        check_consistency::<1>();
+    }
+
+    #[test]
+    fn dual_domain_gradient_is_consistent_where_there_is_material_2d() {
+        check_consistency::<2>();
+    }
+
+    /// `ppc` points per cell and axis at the centres of equal sub-cells (the seeding), each
+    /// with its sub-cell's volume: the whole grid uniformly filled.
+    fn uniform<const D: usize>(g: &Grid<D>, ppc: usize) -> DualDomain<D> {
+        let per_axis = [g.cells * ppc; D];
+        let spacing = g.h / ppc as f64;
+        let positions: Vec<SVector<f64, D>> = (0..per_axis[0].pow(D as u32))
+            .map(|p| {
+                let m = lattice_coords(p, &per_axis);
+                SVector::from_fn(|k, _| (m[k] as f64 + 0.5) * spacing)
+            })
+            .collect();
+        let volumes = vec![spacing.powi(D as i32); positions.len()];
+        let mut dual = DualDomain::new(g);
+        dual.integrate(g, &positions, &volumes).unwrap();
+        dual
+    }
+
+    /// 1D, uniformly filled: the modified gradient of a nodal field u is the hat
+    /// interpolation of the nodal central differences (u_{j+1} - u_{j-1})/(2h), one-sided
+    /// (u_1 - u_0)/h and (u_n - u_{n-1})/h at the end nodes, whose dual domain is a half cell.
+    #[test]
+    fn uniform_fill_interpolates_central_differences_1d() {
+        let g = grid::<1>(8);
+        let dual = uniform(&g, 2);
+        let mut rng = Lcg::new(5);
+        let u: Vec<f64> = (0..=g.cells).map(|_| rng.unit() - 0.5).collect();
+        let n = g.cells;
+        let nodal = |j: usize| match j {
+            0 => (u[1] - u[0]) / g.h,
+            j if j == n => (u[n] - u[n - 1]) / g.h,
+            j => (u[j + 1] - u[j - 1]) / (2.0 * g.h),
+        };
+        for x in (0..200)
+            .map(|_| SVector::<f64, 1>::new(rng.unit()))
+            .chain([SVector::<f64, 1>::new(0.0), SVector::<f64, 1>::new(1.0)])
+        {
+            let entries = basis_at(&dual, &g, &x);
+            let du: f64 = entries.iter().map(|(i, _, gr)| u[*i] * gr[0]).sum();
+            let expected: f64 = entries.iter().map(|(j, s, _)| s * nodal(*j)).sum();
+            assert!((du - expected).abs() < 1e-12, "{x:?}: {du} vs {expected}");
+        }
+    }
+
+    /// 2D, uniformly filled, at cells whose corners are interior nodes: the x-derivative is
+    /// the hat interpolation of central differences along x averaged across y with the
+    /// weights int N_j N_{j+d} dy / int N_j dy, d = -1, 0, 1. The particle quadrature (midpoint
+    /// rule with n points per cell) gives 1/6 + 1/(12 n^2), 2/3 - 1/(6 n^2), 1/6 + 1/(12 n^2),
+    /// the exact integrals 1/6, 2/3, 1/6 as n grows.
+    #[test]
+    fn uniform_fill_averages_central_differences_2d() {
+        let g = grid::<2>(6);
+        let ppc = 2;
+        let dual = uniform(&g, ppc);
+        let side = 1.0 / (12.0 * (ppc * ppc) as f64);
+        let across = [1.0 / 6.0 + side, 2.0 / 3.0 - 2.0 * side, 1.0 / 6.0 + side];
+        let mut rng = Lcg::new(6);
+        let u: Vec<f64> = (0..g.num_nodes()).map(|_| rng.unit() - 0.5).collect();
+        let at = |i: usize, j: usize| u[g.node_index([i, j])];
+        for _ in 0..300 {
+            // Inside cells 1 .. cells - 2 along both axes.
+            let x = SVector::<f64, 2>::from_fn(|_, _| (1.0 + 4.0 * rng.unit()) * g.h);
+            let entries = basis_at(&dual, &g, &x);
+            let du: SVector<f64, 2> = entries.iter().map(|(i, _, gr)| gr * u[*i]).sum();
+            let mut expected = SVector::<f64, 2>::zeros();
+            for (node, s, _) in entries.iter().filter(|e| e.1 > 0.0) {
+                let [i, j] = g.node_coords(*node);
+                for (d, w) in across.iter().enumerate() {
+                    let (ia, ja) = (i + d - 1, j + d - 1);
+                    expected[0] += s * w * (at(i + 1, ja) - at(i - 1, ja)) / (2.0 * g.h);
+                    expected[1] += s * w * (at(ia, j + 1) - at(ia, j - 1)) / (2.0 * g.h);
+                }
+            }
+            assert!(
+                (du - expected).norm() < 1e-12,
+                "{x:?}: {du:?} vs {expected:?}"
+            );
+        }
+    }
+}
