@@ -114,10 +114,10 @@ const fn on_domains(
     }
 }
 
-const fn musl_on(shape: ShapeKind) -> Method {
+const fn musl_on(shape: ShapeKind, transfer: TransferKind) -> Method {
     Method {
         shape,
-        transfer: TransferKind::Shepard,
+        transfer,
         integrator: IntegratorKind::Musl,
     }
 }
@@ -175,24 +175,19 @@ const PRESETS: &[MethodPreset] = &[
     },
     MethodPreset {
         name: "mpm_tls",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Taylor(TLS),
-            integrator: IntegratorKind::Musl,
-        },
+        method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS)),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
         description: "MPM with the conservative TLS mapping and the consistent mass matrix, MUSL",
     },
     MethodPreset {
         name: "mpm_tls_lumped",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Taylor(TaylorRecipe {
+        method: musl_on(
+            ShapeKind::Linear,
+            TransferKind::Taylor(TaylorRecipe {
                 mass: MassMatrix::Lumped,
                 ..TLS
             }),
-            integrator: IntegratorKind::Musl,
-        },
+        ),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
         description: "MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
     },
@@ -258,15 +253,27 @@ const PRESETS: &[MethodPreset] = &[
     },
     MethodPreset {
         name: "bsmpm",
-        method: musl_on(ShapeKind::QuadraticBSpline),
+        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Shepard),
         source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
         description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
     },
     MethodPreset {
         name: "ddmpm",
-        method: musl_on(ShapeKind::DualDomain),
+        method: musl_on(ShapeKind::DualDomain, TransferKind::Shepard),
         source: "Zhang, Ma & Giguere 2011; Wobbes et al. 2018",
         description: "dual-domain MPM: hat values, node-averaged gradient, lumped mass, MUSL",
+    },
+    MethodPreset {
+        name: "bsmpm_tls",
+        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Taylor(TLS)),
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+        description: "B-spline MPM with the conservative TLS mapping on each knot span, MUSL",
+    },
+    MethodPreset {
+        name: "ddmpm_tls",
+        method: musl_on(ShapeKind::DualDomain, TransferKind::Taylor(TLS)),
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+        description: "dual-domain MPM with the conservative TLS mapping, MUSL",
     },
 ];
 

@@ -24,7 +24,7 @@ impl<const D: usize> Stencils<D> {
 
     /// Evaluates the shape functions at every position; on failure returns the index of
     /// the first particle outside the grid.
-    pub fn update<S: Shape<D>>(
+    pub fn update<S: Shape<D> + ?Sized>(
         &mut self,
         shape: &S,
         grid: &Grid<D>,

@@ -79,6 +79,18 @@ enum Mapping {
     Remap,
 }
 
+impl<const D: usize> Basis<D> {
+    /// The basis as a function of position on the grid, for transfers that evaluate it at
+    /// points of their own. Particle domains have none; their grid basis is the hat.
+    fn shape(&self) -> &dyn Shape<D> {
+        match self {
+            Basis::Hat | Basis::Domains(_) => &LinearHat,
+            Basis::BSpline => &QuadraticBSpline,
+            Basis::DualDomain(dual) => dual,
+        }
+    }
+}
+
 /// The state of one run in progress.
 struct Run<'a, const D: usize> {
     spec: &'a RunSpec,
@@ -130,7 +142,7 @@ impl<'a, const D: usize> Run<'a, D> {
             spec,
             method,
             stencils: Stencils::new(per_point, n),
-            transfer: Transfer::new(&method.transfer, &grid, &fixed),
+            transfer: Transfer::new(&method.transfer, &grid, basis.shape(), &fixed),
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
@@ -251,10 +263,13 @@ impl<'a, const D: usize> Run<'a, D> {
                 .stencils
                 .update(&QuadraticBSpline, &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
-            Basis::DualDomain(dual) => dual
-                .integrate(&self.grid, &self.particles.x, &self.particles.volume)
-                .and_then(|()| self.stencils.update(dual, &self.grid, &self.particles.x))
-                .map_err(|particle| Divergence::LeftGrid { particle }),
+            Basis::DualDomain(dual) => {
+                dual.integrate(&self.grid, &self.particles.x, &self.particles.volume)
+                    .and_then(|()| self.stencils.update(dual, &self.grid, &self.particles.x))
+                    .map_err(|particle| Divergence::LeftGrid { particle })?;
+                self.transfer.refresh_basis(dual);
+                Ok(())
+            }
         }
     }
 

@@ -9,7 +9,7 @@ use crate::reconstruct::{
     particles_to_grid, remap_velocity, FitStats, GridState, Lattice, QuadratureTransfer,
     Reconstructor, TaylorTransfer,
 };
-use crate::shape::{Grid, LinearHat, Stencils};
+use crate::shape::{Grid, Shape, Stencils};
 
 pub enum Transfer<const D: usize> {
     Shepard,
@@ -21,7 +21,14 @@ pub enum Transfer<const D: usize> {
 }
 
 impl<const D: usize> Transfer<D> {
-    pub fn new(kind: &TransferKind, grid: &Grid<D>, fixed: &[FixedDof]) -> Self {
+    /// `basis` is the run's grid basis, for transfers that evaluate it at quadrature points
+    /// of their own.
+    pub fn new(
+        kind: &TransferKind,
+        grid: &Grid<D>,
+        basis: &dyn Shape<D>,
+        fixed: &[FixedDof],
+    ) -> Self {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
             TransferKind::Quadrature(recipe) => {
@@ -30,13 +37,9 @@ impl<const D: usize> Transfer<D> {
             TransferKind::FittedVelocity(recipe) => Transfer::FittedVelocity(Box::new(
                 Reconstructor::new(*recipe, Lattice::nodes(grid)),
             )),
-            TransferKind::Taylor(recipe) => Transfer::Taylor(Box::new(TaylorTransfer::new(
-                *recipe,
-                grid,
-                &LinearHat,
-                grid.num_nodes(),
-                fixed,
-            ))),
+            TransferKind::Taylor(recipe) => {
+                Transfer::Taylor(Box::new(TaylorTransfer::new(*recipe, grid, basis, fixed)))
+            }
         }
     }
 
@@ -65,6 +68,14 @@ impl<const D: usize> Transfer<D> {
                 Ok(stats)
             }
             Transfer::Taylor(tls) => tls.map_to_grid(stencils, particles, body_force, grid),
+        }
+    }
+
+    /// Follows a basis that changes with the material (the dual-domain gradient) at the
+    /// transfer's own quadrature points.
+    pub fn refresh_basis(&mut self, basis: &dyn Shape<D>) {
+        if let Transfer::Taylor(tls) = self {
+            tls.refresh_basis(basis);
         }
     }
 

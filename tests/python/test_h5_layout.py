@@ -54,7 +54,9 @@ NORMS = ("l2", "rms")
 
 MASS_UNITS = "kg"
 # Methods whose mappings conserve mass and momentum to round-off.
-CONSERVATIVE_METHODS = ("mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped")
+CONSERVATIVE_METHODS = (
+    "mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped", "bsmpm", "bsmpm_tls", "ddmpm", "ddmpm_tls",
+)
 DIAGNOSTICS = ("reconstructions", "rank_deficient")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
