@@ -58,7 +58,8 @@ impl BandMatrix {
                     sum -= self.get(i, k) * self.get(j, k);
                 }
                 let entry = if j == i {
-                    if !(sum > 0.0) {
+                    // Written so that a NaN pivot fails too.
+                    if sum.is_nan() || sum <= 0.0 {
                         return Err(NotPositiveDefinite { row: i, pivot: sum });
                     }
                     sum.sqrt()
