@@ -18,6 +18,7 @@ pub mod params;
 pub mod particles;
 pub mod reconstruct;
 pub mod reconstruction_methods;
+pub mod reference;
 pub mod report;
 pub mod rng;
 pub mod runner;

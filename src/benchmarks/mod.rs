@@ -6,14 +6,16 @@ mod mms_gong;
 mod mms_tran;
 pub mod scattered;
 mod sine_mms;
+mod vibrating_bar;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::material::NeoHookean;
+use crate::material::Material;
 use crate::params::{ParamError, Params};
 
 pub use mms_gong::{gong_mms, thesis_params};
 pub use sine_mms::SineMms;
+pub use vibrating_bar::{vibrating_bar, VibratingBar};
 
 /// The kind of value a parameter takes; checked by the experiment layer before a run starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +64,7 @@ const CATALOG: &[BenchmarkInfo] = &[
     mms_gong::INFO_1D,
     mms_gong::INFO_2D,
     mms_tran::INFO,
+    vibrating_bar::INFO,
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
 ];
@@ -139,7 +142,7 @@ pub trait Problem<const D: usize>: Send + Sync {
     fn body(&self) -> (SVector<f64, D>, SVector<f64, D>);
     fn ppc(&self) -> usize;
     fn rho0(&self) -> f64;
-    fn material(&self) -> NeoHookean;
+    fn material(&self) -> Material;
     fn dt(&self) -> f64;
     fn steps(&self) -> usize;
     fn fixed_faces(&self) -> FixedFaces<D>;
@@ -164,6 +167,7 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
         "mms1d_gong" => Ok(AnyProblem::D1(Box::new(gong_mms::<1>(params)?))),
         "mms2d_gong" => Ok(AnyProblem::D2(Box::new(gong_mms::<2>(params)?))),
         "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
+        "vibrating_bar" => Ok(AnyProblem::D1(Box::new(vibrating_bar(params)?))),
         other => Err(ParamError::new(
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),

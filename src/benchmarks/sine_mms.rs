@@ -6,7 +6,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec, Problem};
-use crate::material::NeoHookean;
+use crate::material::{Material, NeoHookean};
 
 /// Parameters every manufactured benchmark of this family takes with the same meaning.
 pub const RHO0: ParamSpec = ParamSpec {
@@ -154,8 +154,8 @@ impl<const D: usize> Problem<D> for SineMms<D> {
         self.rho0
     }
 
-    fn material(&self) -> NeoHookean {
-        self.material
+    fn material(&self) -> Material {
+        Material::NeoHookean(self.material)
     }
 
     fn dt(&self) -> f64 {

@@ -4,14 +4,15 @@
 
 use std::collections::HashMap;
 
-use crate::benchmarks::ParamDefault;
+use crate::benchmarks::{self, ParamDefault};
 use crate::params::{ParamError, ParamValue, Params};
+use crate::reference;
 
 use super::document::Benchmark;
 use super::error::ConfigError;
 use super::run_id::{config_body, config_yaml, run_id};
 use super::space::{Block, ParamSpace, Written};
-use super::values::METHOD_KEY;
+use super::values::{method_names, METHOD_KEY};
 use super::yaml::child_field;
 use super::RunSpec;
 
@@ -159,6 +160,13 @@ fn resolve(
         if c.is_axis {
             axes.insert(c.key.to_string(), value.clone());
         }
+    }
+    if let Some(reason) = reference::unsupported(&method, benchmark.info.name) {
+        let error = ParamError::new(METHOD_KEY, reason);
+        let valid = method_names(benchmarks::kind(benchmark.info))
+            .into_iter()
+            .filter(|m| reference::unsupported(m, benchmark.info.name).is_none());
+        return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
     }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
     let body = config_body(benchmark.info.name, &method, output_every, &params);

@@ -3,7 +3,7 @@
 
 use crate::benchmarks::{self, BenchmarkInfo, BenchmarkKind, ParamKind};
 use crate::params::ParamValue;
-use crate::{methods, reconstruction_methods};
+use crate::{methods, reconstruction_methods, reference};
 
 use super::error::ConfigError;
 use super::yaml::{child_field, item_field, Entry, Node, NodeKind};
@@ -18,13 +18,16 @@ pub(crate) enum ValueKind {
     Method(BenchmarkKind),
 }
 
-/// The methods a kind of benchmark accepts: MPM presets for simulations, reconstruction
+/// The methods a kind of benchmark accepts: MPM presets and reference solvers for
+/// simulations (which benchmark a reference solver solves is checked per run), reconstruction
 /// methods for the reconstruction benchmarks.
 pub(crate) fn method_names(kind: BenchmarkKind) -> Vec<&'static str> {
     if kind.is_reconstruction() {
         reconstruction_methods::method_names()
     } else {
-        methods::preset_names()
+        let mut names = methods::preset_names();
+        names.extend(reference::names());
+        names
     }
 }
 

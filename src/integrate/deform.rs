@@ -3,11 +3,12 @@
 use nalgebra::SMatrix;
 
 use super::Divergence;
-use crate::material::{det, NeoHookean};
+use crate::material::{det, Material};
 use crate::particles::Particles;
 
-/// F_p = (I + dt grad v_p) F_p, J_p = det F_p, V_p = J_p V_p^0 and the stress, after checking that the
-/// new state is finite and not inverted. `accel_finite` reports the acceleration gathered in
+/// F_p = (I + dt grad v_p) F_p, J_p = det F_p, V_p = J_p V_p^0 and the stress (from F, or
+/// advanced with grad v for a rate material), after checking that the new state is finite
+/// and not inverted. `accel_finite` reports the acceleration gathered in
 /// the same pass, so that a non-finite grid is caught at the first particle that sees it.
 // Always inlined: it sits in the innermost particle loops, and a call there costs a fifth
 // of the 2D step.
@@ -18,7 +19,7 @@ pub(super) fn deform_particle<const D: usize>(
     grad_v: &SMatrix<f64, D, D>,
     dt: f64,
     accel_finite: bool,
-    material: &NeoHookean,
+    material: &Material,
 ) -> Result<(), Divergence> {
     let f = (SMatrix::<f64, D, D>::identity() + grad_v * dt) * particles.f[p];
     let j = det(&f);
@@ -34,6 +35,6 @@ pub(super) fn deform_particle<const D: usize>(
     particles.f[p] = f;
     particles.j[p] = j;
     particles.volume[p] = j * particles.volume0[p];
-    particles.stress[p] = material.cauchy(&f, j);
+    particles.stress[p] = material.stress(&particles.stress[p], &f, j, grad_v, dt);
     Ok(())
 }

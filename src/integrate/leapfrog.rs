@@ -6,7 +6,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::deform::deform_particle;
 use super::Divergence;
-use crate::material::NeoHookean;
+use crate::material::Material;
 use crate::particles::Particles;
 use crate::reconstruct::GridState;
 use crate::shape::Stencils;
@@ -22,7 +22,7 @@ pub fn update_particles<const D: usize>(
     grid: &GridState<D>,
     kick: f64,
     dt: f64,
-    material: &NeoHookean,
+    material: &Material,
 ) -> Result<(), Divergence> {
     for p in 0..particles.len() {
         let mut a = SVector::<f64, D>::zeros();

@@ -8,7 +8,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::deform::deform_particle;
 use super::Divergence;
-use crate::material::NeoHookean;
+use crate::material::Material;
 use crate::particles::Particles;
 use crate::reconstruct::GridState;
 use crate::shape::Stencils;
@@ -46,7 +46,7 @@ pub fn deform_particles<const D: usize>(
     particles: &mut Particles<D>,
     remapped: &[SVector<f64, D>],
     dt: f64,
-    material: &NeoHookean,
+    material: &Material,
 ) -> Result<(), Divergence> {
     for p in 0..particles.len() {
         let grad_v: SMatrix<f64, D, D> = stencils

@@ -1,10 +1,51 @@
 //! Constitutive models.
 
+mod linear_elastic;
 mod neo_hookean;
 mod tensor;
 
+use nalgebra::SMatrix;
+
+pub use linear_elastic::LinearElasticRate;
 pub use neo_hookean::NeoHookean;
 pub use tensor::det;
+
+/// The constitutive model of a problem, as the particle update sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Hyperelastic: the stress is a function of F.
+    NeoHookean(NeoHookean),
+    /// Hypoelastic: the stress is advanced with the rate of deformation.
+    LinearElasticRate(LinearElasticRate),
+}
+
+impl Material {
+    /// The Cauchy stress after a step of length `dt` with velocity gradient `grad_v` that
+    /// took the deformation gradient to `f` (determinant `j > 0`) from the state with `stress`.
+    #[inline(always)]
+    pub fn stress<const D: usize>(
+        &self,
+        stress: &SMatrix<f64, D, D>,
+        f: &SMatrix<f64, D, D>,
+        j: f64,
+        grad_v: &SMatrix<f64, D, D>,
+        dt: f64,
+    ) -> SMatrix<f64, D, D> {
+        match self {
+            Material::NeoHookean(m) => m.cauchy(f, j),
+            Material::LinearElasticRate(m) => m.advance(stress, grad_v, dt),
+        }
+    }
+
+    /// Small-strain P-wave modulus lambda + 2 mu (1D and plane strain): it sets the elastic
+    /// wave speed and hence the explicit time-step bound.
+    pub fn p_wave_modulus(&self) -> f64 {
+        match self {
+            Material::NeoHookean(m) => m.p_wave_modulus(),
+            Material::LinearElasticRate(m) => m.lambda + 2.0 * m.mu,
+        }
+    }
+}
 
 /// Lame constants from Young's modulus and Poisson's ratio.
 /// (Gong sec 4.5 prints E = lambda(1+mu)(1-2mu)/mu; the inverse used here is the standard

@@ -118,5 +118,7 @@ mod writer;
 pub use atomic::{run_path, write_atomically, write_run};
 pub use reader::read_summary;
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
-pub use record::{Conservation, Diagnostics, Errors, History, ParticleTable, RunRecord};
+pub use record::{
+    Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,
+};
 pub use writer::write_hdf5;

@@ -7,7 +7,7 @@ use crate::methods::Method;
 #[derive(Clone, Debug)]
 pub struct RunRecord {
     pub spec: RunSpec,
-    pub method: Method,
+    pub parts: MethodParts,
     pub dim: usize,
     pub cells: usize,
     pub ppc: usize,
@@ -26,6 +26,24 @@ pub struct RunRecord {
     pub diagnostics: Diagnostics,
     /// Set for the runs of reconstruction benchmarks, which have no particles or history.
     pub reconstruction: Option<ReconstructionRecord>,
+}
+
+/// The root attributes `shape`, `transfer` and `integrator`: what the run's method is made of.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MethodParts {
+    pub shape: String,
+    pub transfer: String,
+    pub integrator: String,
+}
+
+impl From<Method> for MethodParts {
+    fn from(method: Method) -> Self {
+        MethodParts {
+            shape: method.shape.to_string(),
+            transfer: method.transfer.to_string(),
+            integrator: method.integrator.to_string(),
+        }
+    }
 }
 
 /// `/particles`: reference positions (Np x D), masses and initial volumes.

@@ -20,11 +20,11 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     let nt = r.history.time.len();
 
     for (name, value) in [
-        ("shape", r.method.shape.to_string()),
-        ("transfer", r.method.transfer.to_string()),
-        ("integrator", r.method.integrator.to_string()),
+        ("shape", &r.parts.shape),
+        ("transfer", &r.parts.transfer),
+        ("integrator", &r.parts.integrator),
     ] {
-        attr_str(&file, name, &value)?;
+        attr_str(&file, name, value)?;
     }
     attr_i64(&file, "steps", r.steps as i64)?;
     for (name, value) in [("dt", r.dt), ("t_end", r.t_end)] {

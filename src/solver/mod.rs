@@ -3,6 +3,7 @@
 
 mod reconstruction;
 mod recorder;
+mod reference;
 mod transfer;
 
 use std::time::Instant;
@@ -13,7 +14,7 @@ use crate::benchmarks::{self, AnyProblem, Problem};
 use crate::experiment::RunSpec;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
-use crate::output::{Diagnostics, ParticleTable, RunRecord, RunStatus};
+use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
 use crate::reconstruct::{FitStats, GridState};
 use crate::shape::{
@@ -31,6 +32,8 @@ pub fn simulate(spec: &RunSpec) -> RunRecord {
         .is_some_and(|info| benchmarks::kind(info).is_reconstruction());
     let mut record = if is_reconstruction {
         reconstruction::evaluate(spec)
+    } else if crate::reference::method(&spec.method).is_some() {
+        reference::solve(spec)
     } else {
         step(spec)
     };
@@ -158,17 +161,23 @@ impl<'a, const D: usize> Run<'a, D> {
 
     fn execute(mut self) -> RunRecord {
         let (steps, outcome) = self.step_all();
-        let (status, message) = match outcome {
-            Ok(()) => (RunStatus::Ok, String::new()),
-            Err((step, reason)) => (
-                RunStatus::Diverged,
-                format!(
-                    "step {step} (t = {:e}): {reason}",
-                    step as f64 * self.problem.dt()
-                ),
-            ),
-        };
-        self.into_record(steps, status, message)
+        stepped_record(
+            self.spec,
+            Stepped {
+                parts: self.method.into(),
+                h: self.grid.h,
+                dt: self.problem.dt(),
+                planned: self.problem.steps(),
+                steps,
+                outcome,
+                particles: self.particles,
+                recorder: self.recorder,
+                diagnostics: Diagnostics {
+                    reconstructions: self.fits.fits,
+                    rank_deficient: self.fits.rank_deficient,
+                },
+            },
+        )
     }
 
     /// Steps to the final time; returns the steps completed and, on divergence, the step
@@ -308,35 +317,54 @@ impl<'a, const D: usize> Run<'a, D> {
             }
         }
     }
+}
 
-    fn into_record(self, steps: usize, status: RunStatus, message: String) -> RunRecord {
-        let mut record = base_record(self.spec, message);
-        record.method = self.method;
-        record.dim = D;
-        record.h = self.grid.h;
-        record.dt = self.problem.dt();
-        record.t_end = self.problem.dt() * self.problem.steps() as f64;
-        record.steps = steps;
-        record.status = status;
-        record.particles = ParticleTable {
-            x0: self
-                .particles
-                .x0
-                .iter()
-                .flat_map(|x| x.iter().copied())
-                .collect(),
-            mass: self.particles.mass,
-            volume0: self.particles.volume0,
-        };
-        record.history = self.recorder.history;
-        record.errors = self.recorder.errors;
-        record.conservation = self.recorder.conservation;
-        record.diagnostics = Diagnostics {
-            reconstructions: self.fits.fits,
-            rank_deficient: self.fits.rank_deficient,
-        };
-        record
-    }
+/// The end of a stepped run (MPM or a reference solver), whatever method made it.
+struct Stepped<const D: usize> {
+    parts: MethodParts,
+    h: f64,
+    dt: f64,
+    planned: usize,
+    /// Steps completed.
+    steps: usize,
+    /// On divergence, the step that failed and why.
+    outcome: Result<(), (usize, Divergence)>,
+    particles: Particles<D>,
+    recorder: Recorder,
+    diagnostics: Diagnostics,
+}
+
+fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord {
+    let (status, message) = match run.outcome {
+        Ok(()) => (RunStatus::Ok, String::new()),
+        Err((step, reason)) => (
+            RunStatus::Diverged,
+            format!("step {step} (t = {:e}): {reason}", step as f64 * run.dt),
+        ),
+    };
+    let mut record = base_record(spec, message);
+    record.parts = run.parts;
+    record.dim = D;
+    record.h = run.h;
+    record.dt = run.dt;
+    record.t_end = run.dt * run.planned as f64;
+    record.steps = run.steps;
+    record.status = status;
+    record.particles = ParticleTable {
+        x0: run
+            .particles
+            .x0
+            .iter()
+            .flat_map(|x| x.iter().copied())
+            .collect(),
+        mass: run.particles.mass,
+        volume0: run.particles.volume0,
+    };
+    record.history = run.recorder.history;
+    record.errors = run.recorder.errors;
+    record.conservation = run.recorder.conservation;
+    record.diagnostics = run.diagnostics;
+    record
 }
 
 /// The velocity components held at zero: the normal component of the DOFs on each fixed
@@ -364,7 +392,9 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
     let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
     RunRecord {
         spec: spec.clone(),
-        method: methods::preset(&spec.method).map_or(methods::presets()[0].method, |p| p.method),
+        parts: methods::preset(&spec.method)
+            .map_or(methods::presets()[0].method, |p| p.method)
+            .into(),
         dim: benchmarks::info(&spec.benchmark).map_or(0, |b| b.dim),
         cells: int("cells"),
         ppc: int("ppc"),

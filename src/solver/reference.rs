@@ -1,0 +1,75 @@
+//! A run of a reference method (`ulfem`): the same sampling, errors and run record as an MPM
+//! run, with one point per element in place of the particles.
+
+use nalgebra::SVector;
+
+use super::recorder::Recorder;
+use super::{base_record, stepped_record, Stepped};
+use crate::benchmarks::{self, AnyProblem, Problem};
+use crate::experiment::RunSpec;
+use crate::output::{MethodParts, RunRecord};
+use crate::reference::{self, UlFem};
+
+/// Runs `spec`, whose method is a reference method; a benchmark it does not solve makes the
+/// run `failed` with the reason.
+pub(super) fn solve(spec: &RunSpec) -> RunRecord {
+    if let Some(reason) = reference::unsupported(&spec.method, &spec.benchmark) {
+        return base_record(spec, reason);
+    }
+    match benchmarks::build(&spec.benchmark, &spec.params) {
+        Ok(AnyProblem::D1(problem)) => ulfem(spec, problem.as_ref()),
+        Ok(AnyProblem::D2(_)) => base_record(spec, format!("{} is 1D only", spec.method)),
+        Err(e) => base_record(spec, e.to_string()),
+    }
+}
+
+fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>) -> RunRecord {
+    let dt = problem.dt();
+    let planned = problem.steps();
+    let every = spec.output_every;
+    let mut fem = UlFem::new(problem);
+    let mut recorder = Recorder::new();
+    let mut velocity = vec![SVector::zeros(); fem.elements()];
+    let mut outcome = Ok(());
+    let mut steps = planned;
+    for s in 0..=planned {
+        fem.accelerate();
+        if s == 0 || s == planned || (every > 0 && s % every == 0) {
+            let half = if s == 0 { 0.0 } else { 0.5 * dt };
+            let points = fem.points(half, &mut velocity);
+            let t = s as f64 * dt;
+            recorder.sample(s, t, points, &velocity, fem.nodal_mass(), problem);
+        }
+        if s == planned {
+            break;
+        }
+        fem.kick(if s == 0 { 0.5 * dt } else { dt });
+        if let Err(reason) = fem.drift(dt) {
+            outcome = Err((s + 1, reason));
+            steps = s;
+            break;
+        }
+    }
+    let h = problem.domain().upper[0] - problem.domain().lower[0];
+    let mut record = stepped_record(
+        spec,
+        Stepped {
+            parts: MethodParts {
+                shape: "linear finite element".into(),
+                transfer: "none".into(),
+                integrator: "central difference".into(),
+            },
+            h: h / fem.elements() as f64,
+            dt,
+            planned,
+            steps,
+            outcome,
+            particles: fem.into_points(),
+            recorder,
+            diagnostics: Default::default(),
+        },
+    );
+    // One point per element, whatever `ppc` says.
+    record.ppc = 1;
+    record
+}
