@@ -1,19 +1,23 @@
 //! Particle-to-grid transfers: what each method reconstructs on the grid from particle data,
-//! and the local least-squares reconstructions (Shepard, MLS, IMLS) they are built from.
+//! and the local least-squares reconstructions (Shepard, MLS, IMLS, element-wise Taylor least
+//! squares) they are built from.
 
 mod basis;
+mod gauss;
 mod kernel;
 mod lattice;
 mod least_squares;
 mod quadrature;
 mod shepard;
 mod solve;
+mod taylor;
 #[cfg(test)]
 mod tests;
 
 use nalgebra::SVector;
 
 pub use basis::{monomials, Degree, MAX_TERMS};
+pub use gauss::gauss_legendre_rule;
 pub use kernel::{Kernel, Weight};
 #[cfg(test)]
 pub(crate) use lattice::gauss_legendre;
@@ -24,6 +28,7 @@ pub use least_squares::{
 pub use quadrature::{QuadratureRecipe, QuadratureTransfer};
 pub use shepard::{particles_to_grid, remap_velocity};
 pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
+pub use taylor::{taylor_terms, Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
 
 /// Nodal quantities assembled from the particles each step.
 pub struct GridState<const D: usize> {

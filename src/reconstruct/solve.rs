@@ -50,7 +50,7 @@ pub(super) fn add_weighted_outer(a: &mut [f64], stride: usize, w: f64, q: &[f64]
 
 /// The weighted orthogonal polynomials p_i = sum_j coeffs[i][j] q_j of Tran eq 16, built
 /// from the inner products <q_i, q_j> = A_ij (eq 7).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct OrthogonalBasis {
     pub terms: usize,
     /// Unit lower-triangular: p_i = q_i - sum_{k<i} (<q_i, p_k>/<p_k, p_k>) p_k.
@@ -103,12 +103,22 @@ impl OrthogonalBasis {
     /// c of phi_p = w_p q_p . c: u^h = sum_i p_i(x) <p_i, u>/<p_i, p_i> (eq 11, 13) with
     /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point.
     pub fn shape_coefficients(&self) -> [f64; MAX_TERMS] {
+        let mut first = [0.0; MAX_TERMS];
+        first[0] = 1.0;
+        self.solve(&first)
+    }
+
+    /// The least-squares coefficients c of sum_j c_j q_j from rhs_j = <q_j, u>:
+    /// c = sum_i p_i <p_i, u>/<p_i, p_i> over the kept polynomials (the pseudo-inverse of the
+    /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j.
+    pub fn solve(&self, rhs: &[f64; MAX_TERMS]) -> [f64; MAX_TERMS] {
         let mut out = [0.0; MAX_TERMS];
         for i in 0..self.terms {
             if !self.kept[i] {
                 continue;
             }
-            let scale = self.coeffs[i][0] / self.norms[i];
+            let p_i_dot_u: f64 = (0..=i).map(|j| self.coeffs[i][j] * rhs[j]).sum();
+            let scale = p_i_dot_u / self.norms[i];
             for j in 0..=i {
                 out[j] += scale * self.coeffs[i][j];
             }
