@@ -1,5 +1,6 @@
 //! Particle-to-grid transfers: what each method reconstructs on the grid from particle data,
-//! and the local least-squares reconstructions (Shepard, MLS, IMLS) they are built from.
+//! and the local least-squares reconstructions (Shepard, MLS, IMLS, element-wise Taylor least
+//! squares) they are built from.
 
 mod banded;
 mod basis;

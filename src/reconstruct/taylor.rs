@@ -15,6 +15,8 @@
 //! polynomial of the degree it reports. Degree 0 always works: `Fixed` fits nothing (a_1 is
 //! the prescribed mean), `Fitted` fits psi_1 = 1 to at least one point (the average).
 
+use std::fmt;
+
 use nalgebra::SVector;
 
 use super::basis::{Degree, MAX_TERMS};
@@ -127,6 +129,15 @@ impl<const D: usize> TaylorCell<D> {
 pub enum Conservation {
     Fitted,
     Fixed,
+}
+
+impl fmt::Display for Conservation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Conservation::Fitted => "fitted",
+            Conservation::Fixed => "fixed",
+        })
+    }
 }
 
 impl Conservation {
