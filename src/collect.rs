@@ -1,10 +1,14 @@
 //! Gathers what a report needs from a results directory: the experiment (from its copy
-//! beside the runs) and the summary of every run file the experiment expands to.
+//! beside the runs) and the summary of every run file the experiment expands to, with the
+//! final fields along the bar and the errors against the reference run when it names one.
+
+mod compare;
 
 use std::path::Path;
 
+use crate::experiment::FigureKind;
 use crate::experiment::{self, Experiment};
-use crate::output::{read_summary, run_path, RunSummary};
+use crate::output::{read_profile, read_summary, run_path, RunSummary};
 use crate::runner::EXPERIMENT_COPY;
 
 pub struct Collected {
@@ -28,14 +32,30 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
     for spec in &experiment.runs {
         let path = run_path(dir, &spec.run_id);
         if path.exists() {
-            runs.push(read_summary(&path)?);
+            let mut run = read_summary(&path)?;
+            if wants_profiles(&experiment) {
+                run.profile = read_profile(&path)?;
+            }
+            runs.push(run);
         } else {
             missing.push(spec.run_id.clone());
         }
+    }
+    if let Some(select) = &experiment.reference {
+        compare::attach_reference_errors(select, &mut runs);
     }
     Ok(Collected {
         experiment,
         runs,
         missing,
     })
+}
+
+/// Whether the report compares runs with a reference run or draws fields along the bar.
+fn wants_profiles(experiment: &Experiment) -> bool {
+    experiment.reference.is_some()
+        || experiment
+            .figures
+            .iter()
+            .any(|f| f.kind == FigureKind::Profile)
 }

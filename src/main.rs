@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 
 use mpmlab::collect::collect;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions};
-use mpmlab::{benchmarks, experiment, methods, reconstruction_methods, report};
+use mpmlab::{benchmarks, experiment, methods, reconstruction_methods, reference, report};
 
 /// mpmlab: run Material Point Method experiment matrices and report their convergence.
 #[derive(Parser)]
@@ -162,6 +162,11 @@ fn list_methods() {
             preset.name, preset.description, preset.source
         );
         println!("{:<15} {}", "", preset.method);
+    }
+    println!("\nReference solvers (simulation benchmarks they name):");
+    for m in reference::methods() {
+        println!("{:<15} {}  [{}]", m.name, m.description, m.source);
+        println!("{:<15} benchmarks: {}", "", m.benchmarks.join(", "));
     }
     println!("\nReconstruction methods (reconstruction benchmarks; the weight is a parameter):");
     for m in reconstruction_methods::methods() {

@@ -60,6 +60,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         final_norms,
         reconstruction: None,
         velocity_history: None,
+        profile: None,
     }
 }
 
@@ -108,6 +109,7 @@ fn experiment(expect: Vec<Expectation>, figures: Vec<FigureSpec>) -> Experiment 
         expect,
         figures,
         tables: Vec::new(),
+        reference: None,
         runs: Vec::new(),
     }
 }

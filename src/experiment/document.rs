@@ -8,7 +8,7 @@ use super::values::{pick, positive_int};
 use super::yaml::{find, reject_unknown_keys, require, Entry, Node, NodeKind};
 use super::OutputSpec;
 
-const TOP_LEVEL_KEYS: [&str; 9] = [
+const TOP_LEVEL_KEYS: [&str; 10] = [
     "name",
     "description",
     "benchmark",
@@ -18,6 +18,7 @@ const TOP_LEVEL_KEYS: [&str; 9] = [
     "expect",
     "figures",
     "tables",
+    "reference",
 ];
 
 /// The top-level entries, all of known keys.

@@ -12,6 +12,9 @@ use super::stability;
 use super::yaml::{child_field, find, item_field, Entry, Node};
 use super::{FigureKind, FigureSpec};
 
+/// What a profile figure shows without `fields` (Wobbes Fig 4).
+const PROFILE_FIELD: &str = "stress";
+
 const KINDS: Kinds<FigureKind> = Kinds {
     what: "figure",
     kinds: &[
@@ -20,6 +23,7 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("basis", FigureKind::Basis),
         ("stability", FigureKind::Stability),
         ("growth", FigureKind::Growth),
+        ("profile", FigureKind::Profile),
     ],
     keys: &["kind", "fields", "norm", "by", "x", "sweep"],
     takes,
@@ -30,16 +34,17 @@ pub(crate) fn read(
     section: Option<&Entry>,
     space: &ParamSpace,
     benchmark: BenchmarkKind,
+    measures: Measures,
 ) -> Result<Vec<FigureSpec>, ConfigError> {
     KINDS.read_list(section, space, benchmark, |item| {
-        figure(item, space, benchmark)
+        figure(item, space, measures)
     })
 }
 
 fn figure(
     item: Item<FigureKind>,
     space: &ParamSpace,
-    benchmark: BenchmarkKind,
+    measures: Measures,
 ) -> Result<FigureSpec, ConfigError> {
     let Item {
         node,
@@ -56,10 +61,10 @@ fn figure(
         }
         _ => None,
     };
-    let measures = Measures::of(benchmark);
-    let fields = match find(&entries, "fields") {
-        Some(e) => fields(e.value, &child_field(parent, "fields"), measures)?,
-        None => measures.fields.iter().map(|f| f.to_string()).collect(),
+    let fields = match (find(&entries, "fields"), kind) {
+        (Some(e), _) => fields(e.value, &child_field(parent, "fields"), measures)?,
+        (None, FigureKind::Profile) => vec![PROFILE_FIELD.to_string()],
+        (None, _) => measures.fields.iter().map(|f| f.to_string()).collect(),
     };
     let by = match find(&entries, "by") {
         Some(e) => Some(axis_key(e.value, &child_field(parent, "by"), space)?),
@@ -82,6 +87,7 @@ fn takes(kind: &FigureKind) -> &'static [&'static str] {
         FigureKind::Reconstruction | FigureKind::Basis => &[],
         FigureKind::Stability => &["x", "sweep"],
         FigureKind::Growth => &["sweep"],
+        FigureKind::Profile => &["fields"],
     }
 }
 
@@ -91,7 +97,9 @@ fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
         FigureKind::Convergence => true,
         FigureKind::Reconstruction => benchmark.is_reconstruction(),
         FigureKind::Basis => benchmark == BenchmarkKind::OrthogonalBasis,
-        FigureKind::Stability | FigureKind::Growth => benchmark == BenchmarkKind::Simulation,
+        FigureKind::Stability | FigureKind::Growth | FigureKind::Profile => {
+            benchmark == BenchmarkKind::Simulation
+        }
     }
 }
 

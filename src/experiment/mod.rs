@@ -8,6 +8,7 @@ mod expect;
 mod figures;
 mod kinds;
 mod measures;
+mod reference;
 mod run_id;
 mod run_spec;
 mod select;
@@ -53,10 +54,15 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let kind = benchmarks::kind(benchmark.info);
     let space = ParamSpace::read(&sections, benchmark.info)?;
     let output = document::output(&sections)?;
-    let expect = expect::read(sections.get("expect"), &space, Measures::of(kind))?;
-    let figures = figures::read(sections.get("figures"), &space, kind)?;
+    let reference = reference::read(sections.get("reference"), &space, benchmark.info, kind)?;
+    let measures = Measures::of(kind).with_reference(reference.is_some());
+    let expect = expect::read(sections.get("expect"), &space, measures)?;
+    let figures = figures::read(sections.get("figures"), &space, kind, measures)?;
     let tables = tables::read(sections.get("tables"), &space, kind)?;
     let runs = expand::expand(&name, &benchmark, &space, output.every)?;
+    if let (Some(select), Some(section)) = (&reference, sections.get("reference")) {
+        reference::check_unique(select, &runs, section)?;
+    }
     Ok(Experiment {
         name,
         description,
@@ -69,6 +75,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
         expect,
         figures,
         tables,
+        reference,
         runs,
     })
 }
@@ -91,8 +98,18 @@ pub struct Experiment {
     pub expect: Vec<Expectation>,
     pub figures: Vec<FigureSpec>,
     pub tables: Vec<TableSpec>,
+    /// Axis values of the run the others are compared with at the final time (`reference`).
+    pub reference: Option<Params>,
     /// One entry per run, in expansion order (the cartesian product, last axis fastest).
     pub runs: Vec<RunSpec>,
+}
+
+impl Experiment {
+    /// The error fields and norms of its runs: those of its benchmark's kind, and the
+    /// relative error against the reference run when it names one.
+    pub fn measures(&self) -> Measures {
+        Measures::of(self.kind).with_reference(self.reference.is_some())
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -164,6 +181,9 @@ pub enum FigureKind {
     Reconstruction,
     /// Per run: the weighted orthogonal polynomials with the data points on them.
     Basis,
+    /// Fields along the bar at the final time against the current position, one line per
+    /// run, with the reference run as grey markers (Wobbes Fig 4).
+    Profile,
     /// The measured stability limit along `sweep` (last stable and first unstable value)
     /// against `x`, with the predicted bounds when `x` is the particles per cell.
     Stability,

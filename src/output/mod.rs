@@ -13,6 +13,10 @@ pub const SCHEMA_VERSION: i64 = 2;
 pub const ERROR_FIELDS: [&str; 4] = ["displacement", "velocity", "stress", "density"];
 /// The error norms: `l2 = sqrt(sum_p V_p |e_p|^2)`, `rms = sqrt(sum_p |e_p|^2 / Np)`.
 pub const NORMS: [&str; 2] = ["l2", "rms"];
+/// The norms with the relative l2 error against an experiment's reference run (computed by
+/// `collect`, never stored in a run file): ||f - f_ref|| / ||f_ref|| with the l2 norm above.
+pub const NORMS_WITH_REFERENCE: [&str; 3] = ["l2", "rms", REFERENCE_NORM];
+pub const REFERENCE_NORM: &str = "reference";
 
 /// A reconstruction run's error field, u - u^h at the evaluation points.
 pub const RECONSTRUCTION_FIELDS: [&str; 1] = ["u"];
@@ -38,6 +42,18 @@ impl Measures {
                 fields: &ERROR_FIELDS,
                 norms: &NORMS,
             }
+        }
+    }
+
+    /// With the `reference` norm when `compared` (simulations only).
+    pub fn with_reference(self, compared: bool) -> Measures {
+        if compared && self.norms == NORMS {
+            Measures {
+                norms: &NORMS_WITH_REFERENCE,
+                ..self
+            }
+        } else {
+            self
         }
     }
 }
@@ -94,6 +110,35 @@ pub struct RunSummary {
     pub reconstruction: Option<ReconstructionRecord>,
     /// The l2 velocity error at every sample of a simulation run that took any.
     pub velocity_history: Option<VelocityHistory>,
+    /// The state at the last sample of a 1D simulation run, when the report compares runs
+    /// with a reference run or draws fields along the bar (`collect` fills it).
+    pub profile: Option<Profile>,
+}
+
+/// The last sample of a 1D simulation run, one value per particle (per element for a
+/// reference solver), from `/particles`, `/history` and `/errors/volume`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// Reference positions X_p.
+    pub x0: Vec<f64>,
+    pub x: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub stress: Vec<f64>,
+    pub density: Vec<f64>,
+    /// Current volumes, the quadrature weights of the l2 norm.
+    pub volume: Vec<f64>,
+}
+
+impl Profile {
+    /// The values of an error field (`displacement` is x - X).
+    pub fn field(&self, field: &str) -> Vec<f64> {
+        match field {
+            "displacement" => self.x.iter().zip(&self.x0).map(|(x, x0)| x - x0).collect(),
+            "velocity" => self.velocity.clone(),
+            "stress" => self.stress.clone(),
+            _ => self.density.clone(),
+        }
+    }
 }
 
 /// The l2 velocity error over a run beside the size of the solution, which is what a
@@ -116,7 +161,7 @@ mod record;
 mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
-pub use reader::read_summary;
+pub use reader::{read_profile, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,

@@ -5,7 +5,8 @@ use hdf5::types::{TypeDescriptor, VarLenUnicode};
 use hdf5::Location;
 use ndarray::s;
 
-use super::{reconstruction, RunStatus, RunSummary, VelocityHistory, ERROR_FIELDS, NORMS};
+use super::{reconstruction, Profile, RunStatus, RunSummary, VelocityHistory};
+use super::{ERROR_FIELDS, NORMS};
 use super::{RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
 use crate::params::{ParamValue, Params};
 
@@ -46,7 +47,38 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         final_norms,
         reconstruction,
         velocity_history,
+        profile: None,
     })
+}
+
+/// The last sample of a 1D simulation run; `None` for a run without samples.
+pub fn read_profile(path: &Path) -> Result<Option<Profile>, String> {
+    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
+    let file = hdf5::File::open(path).map_err(context)?;
+    let time = file.dataset("history/time").map_err(context)?;
+    let Some(last) = time.size().checked_sub(1) else {
+        return Ok(None);
+    };
+    let read = |name: &str| -> hdf5::Result<Vec<f64>> {
+        let ds = file.dataset(name)?;
+        Ok(match ds.ndim() {
+            2 => ds.read_slice_1d::<f64, _>(s![last, ..])?.to_vec(),
+            3 => ds.read_slice_1d::<f64, _>(s![last, .., 0])?.to_vec(),
+            _ => ds.read_slice_1d::<f64, _>(s![last, .., 0, 0])?.to_vec(),
+        })
+    };
+    let x0 = file.dataset("particles/X").map_err(context)?;
+    Ok(Some(Profile {
+        x0: x0
+            .read_slice_1d::<f64, _>(s![.., 0])
+            .map_err(context)?
+            .to_vec(),
+        x: read("history/x").map_err(context)?,
+        velocity: read("history/v").map_err(context)?,
+        stress: read("history/stress").map_err(context)?,
+        density: read("history/density").map_err(context)?,
+        volume: read("errors/volume").map_err(context)?,
+    }))
 }
 
 /// The l2 velocity error per sample and the l2 norm of the velocity at the first sample;

@@ -10,7 +10,7 @@ use super::group::{self, label, ordered_runs};
 use super::pointwise::Table;
 use super::RateRow;
 use crate::experiment::Experiment;
-use crate::output::{RunStatus, RunSummary};
+use crate::output::{RunStatus, RunSummary, REFERENCE_NORM};
 
 pub fn report_md(
     experiment: &Experiment,
@@ -27,6 +27,7 @@ pub fn report_md(
     }
     overview(&mut md, experiment, &runs);
     runs_table(&mut md, experiment, &runs);
+    reference_table(&mut md, experiment, &runs);
     rates_table(&mut md, rates);
     unfinished(&mut md, experiment, &runs);
     if !tables.is_empty() {
@@ -89,6 +90,47 @@ fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
         if stepped {
             row.push(run.steps.to_string());
         }
+        row
+    });
+    table(md, &header, rows);
+}
+
+/// The relative l2 errors against the reference run (`collect::compare`), one row per run.
+fn reference_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
+    let Some(select) = &experiment.reference else {
+        return;
+    };
+    md.push_str(
+        "## Errors against the reference run
+
+",
+    );
+    let _ = writeln!(
+        md,
+        "Relative l2 error at the final time against the run with {}: \
+         sqrt(sum_p V_p (f_p - f_ref(X_p))^2) / sqrt(sum_p V_p f_ref(X_p)^2) over the run's \
+         particles, with the reference field interpolated in the reference coordinate X \
+         piecewise linearly through the reference's points (element centroids for ULFEM) and \
+         extended linearly past the first and last; the displacement is x - X. The same \
+         numbers are the `reference_<field>` columns of summary.csv and the norm `reference` \
+         of rates.csv.\n",
+        label(select)
+    );
+    let fields = ["displacement", "velocity", "stress"];
+    let mut header = vec!["run".to_string()];
+    header.extend(experiment.axes.iter().cloned());
+    header.push("h".into());
+    header.extend(fields.map(String::from));
+    let rows = runs.iter().map(|run| {
+        let mut row = vec![format!("`{}`", run.run_id)];
+        row.extend(group::axis_values(experiment, run));
+        row.push(h_text(run.h));
+        row.extend(fields.map(|field| {
+            let key = (field.to_string(), REFERENCE_NORM.to_string());
+            run.final_norms
+                .get(&key)
+                .map_or_else(String::new, |&e| general(e, 4))
+        }));
         row
     });
     table(md, &header, rows);

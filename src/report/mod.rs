@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 pub use check::{check, CheckFailure};
 
 use crate::experiment::Experiment;
-use crate::output::{Measures, RunSummary};
+use crate::output::RunSummary;
 use crate::params::Params;
 
 /// The fitted convergence rate of one (group, field, norm): `log10(error) = intercept +
@@ -98,7 +98,7 @@ fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::R
 /// Fits every (group, field, norm) with at least two finished runs of positive, finite
 /// error, sorted by group, then field and norm in the order of the experiment's measures.
 pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
-    let measures = Measures::of(experiment.kind);
+    let measures = experiment.measures();
     let mut rows = Vec::new();
     for g in group::group_runs(runs, &[group::REFINEMENT_AXIS]) {
         for &field in measures.fields {

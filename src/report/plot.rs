@@ -158,7 +158,7 @@ where
         .light_line_style(BLACK.mix(0.08))
         .draw()?;
     for (i, series) in figure.series.iter().enumerate() {
-        let style = curve_style(i);
+        let style = curve_style(i, series);
         if series.dashed {
             chart.draw_series(DashedLineSeries::new(series.line.clone(), 8, 5, style))?;
         } else if !series.line.is_empty() {
@@ -198,7 +198,7 @@ fn draw_legend(area: &Area, figure: &Figure, columns: usize) -> DrawResult {
     let column_width = (WIDTH - MARGIN - Y_LABEL_AREA - MARGIN) as i32 / columns as i32;
     let font = TextStyle::from((FONT, 16).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
     for (i, series) in figure.series.iter().enumerate() {
-        let style = curve_style(i);
+        let style = curve_style(i, series);
         let x = left + (i % columns) as i32 * column_width;
         let y = ((i / columns) as u32 * LEGEND_ROW + LEGEND_ROW / 2) as i32;
         draw_glyph(area, series, (x, y), style)?;
@@ -222,8 +222,13 @@ fn draw_glyph(area: &Area, series: &Series, (x, y): (i32, i32), style: ShapeStyl
     Ok(())
 }
 
-fn curve_style(index: usize) -> ShapeStyle {
-    PALETTE[index % PALETTE.len()].filled().stroke_width(2)
+fn curve_style(index: usize, series: &Series) -> ShapeStyle {
+    let colour = if series.neutral {
+        PALETTE[PALETTE.len() - 1]
+    } else {
+        PALETTE[index % PALETTE.len()]
+    };
+    colour.filled().stroke_width(2)
 }
 
 /// The data range widened by a tenth of its log span on each side (at least a tenth of a

@@ -285,6 +285,7 @@ mod tests {
                 l2_error: errors.to_vec(),
                 initial_l2: 2.0,
             }),
+            profile: None,
         }
     }
 

@@ -26,7 +26,7 @@ const RATE_COLUMNS: [&str; 10] = [
 /// most likely to need quoting).
 pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
     let stepped = !experiment.kind.is_reconstruction();
-    let measures = Measures::of(experiment.kind);
+    let measures = experiment.measures();
     let mut header: Vec<String> = vec!["run_id".into()];
     header.extend(experiment.axes.iter().cloned());
     header.extend(["h", "status"].map(String::from));

@@ -70,6 +70,7 @@ fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
                 marker: Marker::Circle,
                 line,
                 dashed: true,
+                neutral: false,
             });
         }
     }

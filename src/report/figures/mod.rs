@@ -1,5 +1,6 @@
 //! Which figures a report draws and what goes into each; drawing is `plot`'s job.
 
+mod along_bar;
 mod convergence;
 mod profiles;
 mod stability;
@@ -9,7 +10,7 @@ use std::path::PathBuf;
 
 use super::group::{selects, slug};
 use crate::experiment::{Experiment, FigureKind, FigureSpec};
-use crate::output::{Measures, RunSummary};
+use crate::output::RunSummary;
 use crate::params::Params;
 
 /// How the axes of a figure are scaled.
@@ -36,6 +37,8 @@ pub struct Series {
     pub marker: Marker,
     pub line: Vec<(f64, f64)>,
     pub dashed: bool,
+    /// Drawn in grey whatever its place: a reference the other series are judged against.
+    pub neutral: bool,
 }
 
 impl Series {
@@ -46,6 +49,7 @@ impl Series {
             marker,
             line: Vec::new(),
             dashed: false,
+            neutral: false,
         }
     }
 
@@ -56,6 +60,7 @@ impl Series {
             marker: Marker::Circle,
             line: points,
             dashed: false,
+            neutral: false,
         }
     }
 }
@@ -75,7 +80,7 @@ pub struct Figure {
 /// with all fields in the first norm when it asks for none. Figures without a single
 /// usable point are left out.
 pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
-    let measures = Measures::of(experiment.kind);
+    let measures = experiment.measures();
     let default = [FigureSpec {
         kind: FigureKind::Convergence,
         fields: measures.fields.iter().map(|f| f.to_string()).collect(),
@@ -109,6 +114,9 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
             )),
             FigureKind::Growth => figures.extend(stability::growth_figures(
                 experiment, &selected, spec, &mut names,
+            )),
+            FigureKind::Profile => figures.extend(along_bar::figures(
+                experiment, runs, &selected, spec, &mut names,
             )),
         }
     }

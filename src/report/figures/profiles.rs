@@ -63,6 +63,7 @@ pub(super) fn bases(
                     marker: Marker::Circle,
                     line: pairs(&r.curve_x, &basis.curve_p[i * nc..(i + 1) * nc]).collect(),
                     dashed: false,
+                    neutral: false,
                 }
             })
             .collect();

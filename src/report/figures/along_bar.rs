@@ -1,0 +1,84 @@
+//! Fields along the bar at the final time (Wobbes Fig 4): one line per run against the
+//! current position x, the experiment's reference run as grey markers.
+
+use super::{Figure, Names, Scale, Series};
+use crate::experiment::{Experiment, FigureSpec};
+use crate::output::{Profile, RunStatus, RunSummary};
+use crate::report::group::{label, ordered_runs, selects};
+
+/// At most this many reference markers are drawn (every k-th point of the reference).
+const MAX_MARKERS: usize = 80;
+
+/// One figure per field of `spec` over the `selected` runs that finished; `all` holds the
+/// reference run, which need not be selected.
+pub(super) fn figures(
+    experiment: &Experiment,
+    all: &[RunSummary],
+    selected: &[&RunSummary],
+    spec: &FigureSpec,
+    names: &mut Names,
+) -> Vec<Figure> {
+    let is_reference = |run: &RunSummary| {
+        experiment
+            .reference
+            .as_ref()
+            .is_some_and(|select| selects(select, &run.axes))
+    };
+    let reference = all
+        .iter()
+        .find(|run| is_reference(run) && run.status == RunStatus::Ok);
+    let lines: Vec<&RunSummary> = ordered_runs(all)
+        .into_iter()
+        .filter(|run| selected.iter().any(|s| s.run_id == run.run_id))
+        .filter(|run| run.status == RunStatus::Ok && !is_reference(run))
+        .collect();
+    let mut figures = Vec::new();
+    for field in &spec.fields {
+        let mut series: Vec<Series> = lines
+            .iter()
+            .filter_map(|run| {
+                let points = along(run.profile.as_ref()?, field);
+                Some(Series::line(label(&run.axes), points))
+            })
+            .collect();
+        if let Some(run) = reference {
+            if let Some(profile) = &run.profile {
+                let points = along(profile, field);
+                // A fine reference would draw a solid band of markers.
+                let stride = points.len().div_ceil(MAX_MARKERS);
+                let mut s = Series::markers(
+                    format!("reference: {}", label(&run.axes)),
+                    super::Marker::Circle,
+                    points.into_iter().step_by(stride).collect(),
+                );
+                s.neutral = true;
+                series.push(s);
+            }
+        }
+        if series.is_empty() {
+            continue;
+        }
+        let what = format!("{field}_along_bar_{}", label(&spec.select));
+        figures.push(Figure {
+            file: names.file(experiment, &what),
+            title: format!("{}: {field} at the final time", experiment.name),
+            x_label: "x (current position)".into(),
+            y_label: field.clone(),
+            scale: Scale::Linear,
+            series,
+        });
+    }
+    figures
+}
+
+/// (x_p, f_p) in order of x.
+fn along(profile: &Profile, field: &str) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> = profile
+        .x
+        .iter()
+        .copied()
+        .zip(profile.field(field))
+        .collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    points
+}
