@@ -137,21 +137,13 @@ pub fn tran_mms(params: &Params) -> Result<SineMms<1>, ParamError> {
 mod tests {
     use super::*;
     use crate::benchmarks::sine_mms::tests::{check_body_force, probe_points};
-    use crate::benchmarks::{catalog, Problem};
+    use crate::benchmarks::{catalog, default_params, Problem};
     use crate::params::ParamValue;
     use nalgebra::SVector;
 
     /// The catalogue defaults with the given overrides.
     fn params(overrides: &[(&str, ParamValue)]) -> Params {
-        let mut p: Params = PARAMS
-            .iter()
-            .filter_map(|spec| match spec.default {
-                ParamDefault::Float(x) => Some((spec.key.to_string(), ParamValue::Float(x))),
-                ParamDefault::Int(i) => Some((spec.key.to_string(), ParamValue::Int(i))),
-                ParamDefault::Text(t) => Some((spec.key.to_string(), ParamValue::Str(t.into()))),
-                ParamDefault::Required => None,
-            })
-            .collect();
+        let mut p = default_params(PARAMS);
         p.insert("ppc".into(), ParamValue::Int(3));
         p.insert("cells".into(), ParamValue::Int(16));
         for (key, value) in overrides {

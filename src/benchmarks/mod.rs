@@ -11,7 +11,7 @@ mod vibrating_bar;
 use nalgebra::{SMatrix, SVector};
 
 use crate::material::Material;
-use crate::params::{ParamError, Params};
+use crate::params::{ParamError, ParamValue, Params};
 
 pub use mms_gong::{gong_mms, thesis_params};
 pub use sine_mms::SineMms;
@@ -46,6 +46,22 @@ pub struct ParamSpec {
     pub default: ParamDefault,
     pub unit: &'static str,
     pub doc: &'static str,
+}
+
+/// The parameters of `specs` that have a default, at their defaults.
+pub fn default_params(specs: &[ParamSpec]) -> Params {
+    specs
+        .iter()
+        .filter_map(|spec| {
+            let value = match spec.default {
+                ParamDefault::Required => return None,
+                ParamDefault::Int(i) => ParamValue::Int(i),
+                ParamDefault::Float(x) => ParamValue::Float(x),
+                ParamDefault::Text(s) => ParamValue::Str(s.to_string()),
+            };
+            Some((spec.key.to_string(), value))
+        })
+        .collect()
 }
 
 /// Catalogue entry of a benchmark: what `list-benchmarks` prints and what validation uses.

@@ -239,19 +239,11 @@ impl Problem<1> for VibratingBar {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::catalog;
+    use crate::benchmarks::{catalog, default_params};
     use crate::params::ParamValue;
 
     fn params(overrides: &[(&str, ParamValue)]) -> Params {
-        let mut p: Params = PARAMS
-            .iter()
-            .filter_map(|spec| match spec.default {
-                ParamDefault::Float(x) => Some((spec.key.to_string(), ParamValue::Float(x))),
-                ParamDefault::Int(i) => Some((spec.key.to_string(), ParamValue::Int(i))),
-                ParamDefault::Text(t) => Some((spec.key.to_string(), ParamValue::Str(t.into()))),
-                ParamDefault::Required => None,
-            })
-            .collect();
+        let mut p = default_params(PARAMS);
         p.insert("cells".into(), ParamValue::Int(10));
         for (key, value) in overrides {
             p.insert(key.to_string(), value.clone());

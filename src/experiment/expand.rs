@@ -4,8 +4,8 @@
 
 use std::collections::HashMap;
 
-use crate::benchmarks::{self, ParamDefault};
-use crate::params::{ParamError, ParamValue, Params};
+use crate::benchmarks;
+use crate::params::{ParamError, Params};
 use crate::reference;
 
 use super::document::Benchmark;
@@ -26,7 +26,7 @@ pub(crate) fn expand(
     output_every: usize,
 ) -> Result<Vec<RunSpec>, ConfigError> {
     run_count(space)?;
-    let defaults = defaults(benchmark);
+    let defaults = benchmarks::default_params(benchmark.info.params);
     let mut runs: Vec<RunSpec> = Vec::new();
     // Run id -> its block, to refuse a run that two blocks both make.
     let mut made_by: HashMap<String, usize> = HashMap::new();
@@ -50,21 +50,6 @@ pub(crate) fn expand(
         }
     }
     Ok(runs)
-}
-
-/// The benchmark's parameters that have a default, at their defaults.
-fn defaults(benchmark: &Benchmark) -> Params {
-    let mut defaults = Params::new();
-    for p in benchmark.info.params {
-        let value = match p.default {
-            ParamDefault::Required => continue,
-            ParamDefault::Int(i) => ParamValue::Int(i),
-            ParamDefault::Float(x) => ParamValue::Float(x),
-            ParamDefault::Text(s) => ParamValue::Str(s.to_string()),
-        };
-        defaults.insert(p.key.to_string(), value);
-    }
-    defaults
 }
 
 /// Runs of one block, saturating: `run_count` rejects the sums that overflow.
@@ -225,10 +210,11 @@ fn check_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{BenchmarkInfo, ParamKind, ParamSpec};
+    use crate::benchmarks::{BenchmarkInfo, ParamDefault, ParamKind, ParamSpec};
     use crate::experiment::error::Pos;
     use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
+    use crate::params::ParamValue;
 
     /// A benchmark whose check rejects its own default, which no real benchmark does.
     const TOY: BenchmarkInfo = BenchmarkInfo {

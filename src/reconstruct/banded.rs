@@ -54,7 +54,8 @@ impl BandMatrix {
             let first = i.saturating_sub(b);
             for j in first..=i {
                 let mut sum = self.get(i, j);
-                for k in first.max(j.saturating_sub(b))..j {
+                // Rows i and j (j <= i) both hold entries k >= i - b = first.
+                for k in first..j {
                     sum -= self.get(i, k) * self.get(j, k);
                 }
                 let entry = if j == i {

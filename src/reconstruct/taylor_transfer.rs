@@ -61,7 +61,9 @@ pub struct TaylorTransfer<const D: usize> {
     points: Vec<SVector<f64, D>>,
     density: Vec<f64>,
     values: Vec<f64>,
-    prescribed: TaylorFit<D>,
+    /// Per element, the fit with the element's mass and momentum prescribed, factorised at the
+    /// mapping and reused by the remap, which fits the same points.
+    prescribed: Vec<TaylorFit<D>>,
     fitted: TaylorFit<D>,
     /// Consistent mass matrix in DOF numbering, and per component its factor restricted to
     /// the DOFs that carry mass and are free (`free[k]` lists them in order).
@@ -135,7 +137,7 @@ impl<const D: usize> TaylorTransfer<D> {
             points: Vec::new(),
             density: Vec::new(),
             values: Vec::new(),
-            prescribed: TaylorFit::default(),
+            prescribed: (0..elements).map(|_| TaylorFit::default()).collect(),
             fitted: TaylorFit::default(),
             mass_matrix: BandMatrix::default(),
             factors: vec![BandMatrix::default(); D],
@@ -172,12 +174,11 @@ impl<const D: usize> TaylorTransfer<D> {
         let degree = self.recipe.degree;
         let mut stats = FitStats::default();
         for e in 0..self.elements() {
-            let (start, end) = self.range(e);
-            if start == end {
+            let Some((start, end)) = self.particles_of(e) else {
                 continue;
-            }
+            };
             let cell = self.cell(e);
-            let prescribed = self.prescribed.factor(
+            let prescribed = self.prescribed[e].factor(
                 &cell,
                 degree,
                 Conservation::Fixed,
@@ -195,10 +196,8 @@ impl<const D: usize> TaylorTransfer<D> {
                 .iter()
                 .map(|&p| particles.mass[p as usize])
                 .sum();
-            let rho = self
-                .prescribed
-                .solve(&self.density[start..end], mass / cell.volume());
-            let rho_v = self.momentum_density(&cell, start, end, &particles.v, &particles.mass);
+            let rho = self.prescribed[e].solve(&self.density[start..end], mass / cell.volume());
+            let rho_v = self.momentum_density(e, &cell, &particles.v, &particles.mass);
             let sigma = self.stress(start, end, &particles.stress);
             for q in 0..self.per_element {
                 let g = e * self.per_element + q;
@@ -229,13 +228,13 @@ impl<const D: usize> TaylorTransfer<D> {
             self.factor_mass_matrix(grid)?;
         }
         self.momentum_total = grid.velocity.iter().sum();
-        self.solve_mass(grid, Target::Velocity);
+        self.solve(&grid.mass, grid.empty_mass, &mut grid.velocity);
         Ok(stats)
     }
 
-    /// MUSL's v_i^L: the momentum density of the particle velocities `v` reconstructed on the
-    /// elements and positions of this step's mapping, integrated (eq 9) and solved with its
-    /// mass matrix (eq 11).
+    /// MUSL's v_i^L: the momentum density of the particle velocities `v` reconstructed with
+    /// the fits of this step's mapping (same elements and positions), integrated (eq 9) and
+    /// solved with its mass matrix (eq 11).
     pub fn remap_velocity(
         &mut self,
         particles: &Particles<D>,
@@ -244,18 +243,12 @@ impl<const D: usize> TaylorTransfer<D> {
     ) {
         out.fill(SVector::zeros());
         for e in 0..self.elements() {
-            let (start, end) = self.range(e);
-            if start == end {
+            if self.particles_of(e).is_none() {
                 continue;
             }
             let cell = self.cell(e);
-            let degree = self.prescribed.factor(
-                &cell,
-                self.recipe.degree,
-                Conservation::Fixed,
-                &self.points[start..end],
-            );
-            let rho_v = self.momentum_density(&cell, start, end, &particles.v, &particles.mass);
+            let degree = self.prescribed[e].degree();
+            let rho_v = self.momentum_density(e, &cell, &particles.v, &particles.mass);
             for q in 0..self.per_element {
                 let g = e * self.per_element + q;
                 let rho_v_g =
@@ -266,13 +259,13 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         self.momentum_total = out.iter().sum();
-        self.solve(grid, out);
+        self.solve(&grid.mass, grid.empty_mass, out);
     }
 
     /// The grid solve with this transfer's mass matrix: a = M^-1 f, v_new = v + kick a, fixed
     /// components and empty DOFs held at zero. Afterwards `force` holds a.
     pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) {
-        self.solve_mass(grid, Target::Force);
+        self.solve(&grid.mass, grid.empty_mass, &mut grid.force);
         for i in 0..grid.mass.len() {
             grid.velocity_new[i] = grid.velocity[i] + grid.force[i] * kick;
         }
@@ -289,15 +282,15 @@ impl<const D: usize> TaylorTransfer<D> {
     }
 
     /// Taylor coefficients of rho v on element `e` with the element momentum prescribed
-    /// (eq 5), from the particles sorted into [start, end); `prescribed` must be factorised.
+    /// (eq 5); the element's prescribed fit must be factorised.
     fn momentum_density(
         &mut self,
+        e: usize,
         cell: &TaylorCell<D>,
-        start: usize,
-        end: usize,
         v: &[SVector<f64, D>],
         mass: &[f64],
     ) -> [SVector<f64, D>; MAX_TAYLOR_TERMS] {
+        let (start, end) = self.range(e);
         let mut coefficients = [SVector::zeros(); MAX_TAYLOR_TERMS];
         for k in 0..D {
             self.values.clear();
@@ -307,9 +300,7 @@ impl<const D: usize> TaylorTransfer<D> {
                 self.values.push(rho * v[p][k]);
                 momentum += mass[p] * v[p][k];
             }
-            let a = self
-                .prescribed
-                .solve(&self.values, momentum / cell.volume());
+            let a = self.prescribed[e].solve(&self.values, momentum / cell.volume());
             for (c, a) in coefficients.iter_mut().zip(a) {
                 c[k] = a;
             }
@@ -376,27 +367,15 @@ impl<const D: usize> TaylorTransfer<D> {
         Ok(())
     }
 
-    /// Solves M x = b in place for the nodal field `target` of `grid`.
-    fn solve_mass(&mut self, grid: &mut GridState<D>, target: Target) {
-        let mut field = std::mem::take(match target {
-            Target::Velocity => &mut grid.velocity,
-            Target::Force => &mut grid.force,
-        });
-        self.solve(grid, &mut field);
-        match target {
-            Target::Velocity => grid.velocity = field,
-            Target::Force => grid.force = field,
-        }
-    }
-
-    /// Solves M x = b in place; x is zero at fixed components and at DOFs without mass.
-    fn solve(&mut self, grid: &GridState<D>, field: &mut [SVector<f64, D>]) {
+    /// Solves M x = b in place for a nodal field; x is zero at fixed components and at DOFs
+    /// whose lumped mass `mass` is at most `empty_mass`.
+    fn solve(&mut self, mass: &[f64], empty_mass: f64, field: &mut [SVector<f64, D>]) {
         match self.recipe.mass {
             MassMatrix::Lumped => {
                 for (i, x) in field.iter_mut().enumerate() {
-                    let m = grid.mass[i];
+                    let m = mass[i];
                     for k in 0..D {
-                        x[k] = if m > grid.empty_mass && !self.fixed[i][k] {
+                        x[k] = if m > empty_mass && !self.fixed[i][k] {
                             x[k] / m
                         } else {
                             0.0
@@ -428,6 +407,12 @@ impl<const D: usize> TaylorTransfer<D> {
         let c = lattice_coords(e, &[self.grid.cells; D]);
         let lower = SVector::from_fn(|k, _| self.grid.lower[k] + c[k] as f64 * self.grid.h);
         TaylorCell::new(lower, lower.add_scalar(self.grid.h))
+    }
+
+    /// The range of element `e`'s particles in the sorted order, if it has any.
+    fn particles_of(&self, e: usize) -> Option<(usize, usize)> {
+        let (start, end) = self.range(e);
+        (start < end).then_some((start, end))
     }
 
     fn range(&self, e: usize) -> (usize, usize) {
@@ -474,13 +459,6 @@ impl<const D: usize> TaylorTransfer<D> {
         }
         Ok(())
     }
-}
-
-/// Which nodal field a mass solve acts on.
-#[derive(Clone, Copy)]
-enum Target {
-    Velocity,
-    Force,
 }
 
 /// sum_t c_t psi_t for coefficients of any linear type.

@@ -95,6 +95,7 @@ mod tests {
 
     use super::*;
     use crate::benchmarks::Domain;
+    use crate::shape::stencils::assert_gradient_matches_differences;
     use crate::shape::{lattice_coords, Stencils};
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
@@ -216,39 +217,11 @@ mod tests {
     /// Gradients agree with central differences of the values, in every cell (1D and 2D).
     fn check_gradient<const D: usize>() {
         let g = grid::<D>(4);
-        let per_point = Shape::<D>::nodes_per_point(&QuadraticBSpline);
-        let value = |y: &SVector<f64, D>, node: usize| {
-            let mut st = Stencils::new(per_point, 1);
-            st.update(&QuadraticBSpline, &g, std::slice::from_ref(y))
-                .unwrap();
-            let w = st
-                .of(0)
-                .find(|(i, _, _)| *i == node)
-                .map_or(0.0, |(_, w, _)| w);
-            w
-        };
-        let eps = 1e-6;
         let mut rng = crate::rng::Lcg::new(77);
         for c in 0..g.cells {
             // A point inside cell c along every axis, away from the faces.
             let x = g.lower + SVector::from_fn(|_, _| (c as f64 + 0.1 + 0.8 * rng.unit()) * g.h);
-            let mut st = Stencils::new(per_point, 1);
-            st.update(&QuadraticBSpline, &g, std::slice::from_ref(&x))
-                .unwrap();
-            for (i, _, grad) in st.of(0) {
-                for k in 0..D {
-                    let mut xp = x;
-                    let mut xm = x;
-                    xp[k] += eps;
-                    xm[k] -= eps;
-                    let fd = (value(&xp, i) - value(&xm, i)) / (2.0 * eps);
-                    assert!(
-                        (fd - grad[k]).abs() < 1e-7,
-                        "DOF {i} axis {k}: {fd} vs {}",
-                        grad[k]
-                    );
-                }
-            }
+            assert_gradient_matches_differences(&QuadraticBSpline, &g, &x, 1e-7);
         }
     }
 

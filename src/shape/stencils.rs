@@ -56,6 +56,43 @@ impl<const D: usize> Stencils<D> {
     }
 }
 
+/// Asserts that the gradients `shape` gives at `x` agree with central differences of its
+/// values within `tolerance`; `x` must be away from cell faces, where values have kinks.
+#[cfg(test)]
+pub(crate) fn assert_gradient_matches_differences<S: Shape<D>, const D: usize>(
+    shape: &S,
+    grid: &Grid<D>,
+    x: &SVector<f64, D>,
+    tolerance: f64,
+) {
+    let stencil = |y: &SVector<f64, D>| {
+        let mut st = Stencils::new(shape.nodes_per_point(), 1);
+        st.update(shape, grid, std::slice::from_ref(y)).unwrap();
+        st
+    };
+    let value = |y: &SVector<f64, D>, node: usize| {
+        stencil(y)
+            .of(0)
+            .find(|(i, _, _)| *i == node)
+            .map_or(0.0, |(_, w, _)| w)
+    };
+    let eps = 1e-6;
+    for (i, _, grad) in stencil(x).of(0) {
+        for k in 0..D {
+            let mut xp = *x;
+            let mut xm = *x;
+            xp[k] += eps;
+            xm[k] -= eps;
+            let fd = (value(&xp, i) - value(&xm, i)) / (2.0 * eps);
+            assert!(
+                (fd - grad[k]).abs() < tolerance,
+                "node {i} axis {k} at {x:?}: {fd} vs {}",
+                grad[k]
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,34 +150,8 @@ mod tests {
     /// Gradients agree with central differences of the values away from cell faces.
     #[test]
     fn linear_hat_gradient_matches_finite_differences_2d() {
-        let g = grid::<2>(5);
         let x = SVector::<f64, 2>::new(0.31, 0.77);
-        let value = |y: &SVector<f64, 2>, node: usize| {
-            let mut st = Stencils::new(4, 1);
-            st.update(&LinearHat, &g, std::slice::from_ref(y)).unwrap();
-            let w = st
-                .of(0)
-                .find(|(i, _, _)| *i == node)
-                .map_or(0.0, |(_, w, _)| w);
-            w
-        };
-        let mut st = Stencils::new(4, 1);
-        st.update(&LinearHat, &g, std::slice::from_ref(&x)).unwrap();
-        let eps = 1e-6;
-        for (i, _, grad) in st.of(0) {
-            for k in 0..2 {
-                let mut xp = x;
-                let mut xm = x;
-                xp[k] += eps;
-                xm[k] -= eps;
-                let fd = (value(&xp, i) - value(&xm, i)) / (2.0 * eps);
-                assert!(
-                    (fd - grad[k]).abs() < 1e-8,
-                    "node {i} axis {k}: {fd} vs {}",
-                    grad[k]
-                );
-            }
-        }
+        assert_gradient_matches_differences(&LinearHat, &grid::<2>(5), &x, 1e-8);
     }
 
     #[test]
