@@ -313,5 +313,6 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         conservation: Default::default(),
         diagnostics: Default::default(),
         reconstruction: None,
+        elements: None,
     }
 }
