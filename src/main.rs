@@ -168,22 +168,28 @@ fn list_methods() {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
         println!("{:<15} benchmarks: {}", "", m.benchmarks.join(", "));
     }
-    println!("\nReconstruction methods (reconstruction benchmarks; the weight is a parameter):");
+    println!(
+        "\nReconstruction methods (reconstruction benchmarks; the weight of a local fit is a \
+         parameter, tls_* serve recon_tls):"
+    );
     for m in reconstruction_methods::methods() {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
-        println!("{:<15} degree={} solver={}", "", m.degree.value(), m.solver);
+        println!("{:<15} degree={} fit={}", "", m.degree.value(), m.fit);
     }
 }
 
 fn list_benchmarks() {
     for b in benchmarks::catalog() {
+        let kind = benchmarks::kind(b);
+        // The element-wise benchmark runs in its function's dimension.
+        let dims = if kind == benchmarks::BenchmarkKind::Elementwise {
+            format!("1D or {}D", b.dim)
+        } else {
+            format!("{}D", b.dim)
+        };
         println!(
-            "{} ({}D, {}) - {} [{}]",
-            b.name,
-            b.dim,
-            benchmarks::kind(b),
-            b.description,
-            b.source
+            "{} ({dims}, {kind}) - {} [{}]",
+            b.name, b.description, b.source
         );
         for p in b.params {
             let default = match p.default {

@@ -778,6 +778,21 @@ tables:
   - {kind: basis_norms}
 ";
 
+const ELEMENTS: &str = "\
+name: tls
+benchmark: recon_tls
+params: {function: sin_x_cos_y, lower: 0.0, upper: 5.0, spacing: interior, ppc: 2, ppc_y: 3}
+matrix:
+  method: [tls_fixed, tls_fitted]
+  cells: [5, 10]
+expect:
+  - {method: tls_fixed, field: u, norm: rms, error_min: 6.0e-3, error_max: 7.0e-3}
+figures:
+  - {kind: reconstruction, method: tls_fixed}
+tables:
+  - {kind: element_fits}
+";
+
 fn edited_in(valid: &str, from: &str, to: &str) -> String {
     let text = valid.replacen(from, to, 1);
     assert_ne!(text, valid, "'{from}' is not in the file");
@@ -1089,4 +1104,57 @@ fn stability_keys_are_located_with_their_choices() {
         let e = error(&edited_in(base, from, to));
         check(&e, line, column, field, message, valid);
     }
+}
+
+/// The element-wise benchmark takes the tls methods, its own norms and table, and its checks
+/// name the parameter at fault; error bounds must be ordered.
+#[test]
+fn element_wise_experiments_are_checked() {
+    let exp = parse(ELEMENTS).unwrap();
+    assert_eq!(exp.runs.len(), 4);
+    let e = error(&edited_in(
+        ELEMENTS,
+        "[tls_fixed, tls_fitted]",
+        "[mls_linear]",
+    ));
+    check(
+        &e,
+        5,
+        12,
+        "matrix.method[0]",
+        "unknown method 'mls_linear'",
+        &["tls_fixed", "tls_fitted"],
+    );
+    let e = error(&edited_in(ELEMENTS, "spacing: interior", "spacing: mixed"));
+    assert_eq!(e.field, "params.spacing", "{e}");
+    assert!(e.message.contains("defined in 1D only"), "{e}");
+    let e = error(&edited_in(
+        ELEMENTS,
+        "function: sin_x_cos_y",
+        "function: x2",
+    ));
+    assert_eq!(e.field, "params.ppc_y", "{e}");
+    let e = error(&edited_in(ELEMENTS, "norm: rms", "norm: l2"));
+    check(
+        &e,
+        8,
+        41,
+        "expect[0].norm",
+        "unknown norm 'l2'",
+        &["rms", "integral"],
+    );
+    let e = error(&edited_in(
+        ELEMENTS,
+        "error_max: 7.0e-3",
+        "error_max: 5.0e-3",
+    ));
+    assert_eq!(e.field, "expect[0].error_max", "{e}");
+    assert!(e.message.contains("is below error_min"), "{e}");
+    let e = error(&edited_in(
+        ELEMENTS,
+        "kind: element_fits",
+        "kind: nodal_errors",
+    ));
+    assert_eq!(e.field, "tables[0].kind", "{e}");
+    assert!(e.valid.contains(&"element_fits".to_string()), "{e}");
 }

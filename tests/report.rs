@@ -59,6 +59,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
         final_norms,
         reconstruction: None,
+        elements: None,
         velocity_history: None,
         profile: None,
     }
@@ -121,6 +122,7 @@ fn expect(line: usize, select: &[(&str, &str)], field: &str) -> Expectation {
         norm: "l2".into(),
         rate_min: None,
         rate_max: None,
+        error_min: None,
         error_max: None,
         limit: None,
         line,

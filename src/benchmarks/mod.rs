@@ -67,6 +67,7 @@ pub fn default_params(specs: &[ParamSpec]) -> Params {
 /// Catalogue entry of a benchmark: what `list-benchmarks` prints and what validation uses.
 pub struct BenchmarkInfo {
     pub name: &'static str,
+    /// The spatial dimension; for `recon_tls`, whose runs take their function's, the largest.
     pub dim: usize,
     pub source: &'static str,
     pub description: &'static str,
@@ -83,6 +84,7 @@ const CATALOG: &[BenchmarkInfo] = &[
     vibrating_bar::INFO,
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
+    scattered::INFO_ELEMENTS,
 ];
 
 /// What a run of a benchmark computes, and so which methods, measures and figures apply.
@@ -94,6 +96,9 @@ pub enum BenchmarkKind {
     Reconstruction,
     /// A reconstruction that also records the weighted orthogonal basis of its points.
     OrthogonalBasis,
+    /// Sampled data reconstructed element by element (Taylor least squares); errors at
+    /// Gauss points.
+    Elementwise,
 }
 
 impl BenchmarkKind {
@@ -108,6 +113,7 @@ impl std::fmt::Display for BenchmarkKind {
             BenchmarkKind::Simulation => "simulation",
             BenchmarkKind::Reconstruction => "nodal reconstruction",
             BenchmarkKind::OrthogonalBasis => "orthogonal-basis reconstruction",
+            BenchmarkKind::Elementwise => "element-wise reconstruction",
         })
     }
 }

@@ -13,17 +13,18 @@ use super::values::{finite, positive};
 use super::yaml::{child_field, find, read_list, require, Entry, Node};
 use super::{Expectation, LimitBound};
 
-const KEYS: [&str; 8] = [
+const KEYS: [&str; 9] = [
     "field",
     "norm",
     "rate_min",
     "rate_max",
+    "error_min",
     "error_max",
     "sweep",
     "limit_min",
     "limit_max",
 ];
-const BOUNDS: [&str; 3] = ["rate_min", "rate_max", "error_max"];
+const BOUNDS: [&str; 4] = ["rate_min", "rate_max", "error_min", "error_max"];
 /// The keys of a stability-limit entry; the others belong to rate and error entries.
 const LIMIT_KEYS: [&str; 3] = ["sweep", "limit_min", "limit_max"];
 /// What the stability criterion reads (`report::stability`).
@@ -83,8 +84,12 @@ fn read_entry(
     };
     let rate_min = bound("rate_min", finite)?;
     let rate_max = bound("rate_max", finite)?;
+    let error_min = bound("error_min", positive)?;
     let error_max = bound("error_max", positive)?;
-    if rate_min.is_none() && rate_max.is_none() && error_max.is_none() {
+    if [rate_min, rate_max, error_min, error_max]
+        .iter()
+        .all(Option::is_none)
+    {
         return Err(
             ConfigError::at(node.pos, parent, "an expectation needs at least one bound")
                 .with_valid(BOUNDS),
@@ -93,12 +98,16 @@ fn read_entry(
     if let (Some(min), Some(max)) = (rate_min, rate_max) {
         ordered(&entries, node, parent, "rate", min, max)?;
     }
+    if let (Some(min), Some(max)) = (error_min, error_max) {
+        ordered(&entries, node, parent, "error", min, max)?;
+    }
     Ok(Expectation {
         select,
         field,
         norm: norm(&entries, parent, measures)?,
         rate_min,
         rate_max,
+        error_min,
         error_max,
         limit: None,
         line: node.pos.line,
@@ -126,6 +135,7 @@ fn read_limit(
         norm: LIMIT_NORM.to_string(),
         rate_min: None,
         rate_max: None,
+        error_min: None,
         error_max: None,
         limit: Some(LimitBound { sweep, min, max }),
         line: node.pos.line,

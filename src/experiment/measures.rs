@@ -7,8 +7,6 @@ use super::error::ConfigError;
 use super::values::choice;
 use super::yaml::{child_field, find, Entry, Node};
 
-const DEFAULT_NORM: &str = "l2";
-
 pub(crate) fn error_field(
     node: &Node,
     field: &str,
@@ -17,7 +15,8 @@ pub(crate) fn error_field(
     choice(node, field, "field", measures.fields)
 }
 
-/// The optional `norm` entry of a map at `parent`, `l2` when absent.
+/// The optional `norm` entry of a map at `parent`; when absent the kind's first norm (`l2`
+/// for simulations and nodal reconstructions, `rms` for element-wise ones).
 pub(crate) fn norm(
     entries: &[Entry],
     parent: &str,
@@ -30,6 +29,6 @@ pub(crate) fn norm(
             "norm",
             measures.norms,
         ),
-        None => Ok(DEFAULT_NORM.to_string()),
+        None => Ok(measures.norms[0].to_string()),
     }
 }

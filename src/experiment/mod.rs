@@ -145,7 +145,8 @@ pub struct Expectation {
     pub norm: String,
     pub rate_min: Option<f64>,
     pub rate_max: Option<f64>,
-    /// Upper bound on the final error of every matching run.
+    /// Bounds on the final error of every matching run: a printed value is matched by both.
+    pub error_min: Option<f64>,
     pub error_max: Option<f64>,
     /// A stability-limit expectation (`sweep`, `limit_min`, `limit_max`); its `field` and
     /// `norm` are those the stability criterion reads (velocity, l2).
@@ -177,7 +178,8 @@ pub struct StabilityAxes {
 pub enum FigureKind {
     /// log10(error) against log10(h) with fitted slopes.
     Convergence,
-    /// Per run: u(x), the reconstructed nodal values and the data points.
+    /// Per run: u(x), the reconstructed nodal values (or each element's fit) and the data
+    /// points.
     Reconstruction,
     /// Per run: the weighted orthogonal polynomials with the data points on them.
     Basis,
@@ -213,6 +215,9 @@ pub enum TableKind {
     /// One row per value of `x`: the measured stability limit along `sweep` and the
     /// predicted bounds.
     Stability,
+    /// One row per element-wise run: RMS and integral errors, and the elements whose fit
+    /// dropped a degree (Wobbes sec 2.1).
+    ElementFits,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,7 @@
 //! `tables` entries: the tables that report.md prints beside the rates: pointwise values of
 //! the reconstruction benchmarks (the counterparts of Gong's Tables 4.1-4.2 and of the
-//! <p_i, p_i> of Tran's Figs 1-3) and measured stability limits.
+//! <p_i, p_i> of Tran's Figs 1-3), the errors of element-wise fits (Wobbes sec 2.1) and
+//! measured stability limits.
 
 use crate::benchmarks::BenchmarkKind;
 
@@ -18,6 +19,7 @@ const KINDS: Kinds<TableKind> = Kinds {
         ("nodal_errors", TableKind::NodalErrors),
         ("basis_norms", TableKind::BasisNorms),
         ("stability", TableKind::Stability),
+        ("element_fits", TableKind::ElementFits),
     ],
     keys: &["kind", "columns", "x", "sweep"],
     takes,
@@ -72,7 +74,7 @@ fn table(item: Item<TableKind>, space: &ParamSpace) -> Result<TableSpec, ConfigE
 fn takes(kind: &TableKind) -> &'static [&'static str] {
     match kind {
         TableKind::NodalErrors => &["columns"],
-        TableKind::BasisNorms => &[],
+        TableKind::BasisNorms | TableKind::ElementFits => &[],
         TableKind::Stability => &["x", "sweep"],
     }
 }
@@ -80,8 +82,12 @@ fn takes(kind: &TableKind) -> &'static [&'static str] {
 /// Whether runs of `benchmark` hold what a table of `kind` lists.
 fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
     match kind {
-        TableKind::NodalErrors => benchmark.is_reconstruction(),
+        TableKind::NodalErrors => matches!(
+            benchmark,
+            BenchmarkKind::Reconstruction | BenchmarkKind::OrthogonalBasis
+        ),
         TableKind::BasisNorms => benchmark == BenchmarkKind::OrthogonalBasis,
         TableKind::Stability => benchmark == BenchmarkKind::Simulation,
+        TableKind::ElementFits => benchmark == BenchmarkKind::Elementwise,
     }
 }

@@ -19,16 +19,21 @@ pub(crate) enum ValueKind {
 }
 
 /// The methods a kind of benchmark accepts: MPM presets and reference solvers for
-/// simulations (which benchmark a reference solver solves is checked per run), reconstruction
-/// methods for the reconstruction benchmarks.
+/// simulations (which benchmark a reference solver solves is checked per run), the
+/// element-wise reconstruction methods for the element-wise benchmark, the local ones for the
+/// other reconstruction benchmarks.
 pub(crate) fn method_names(kind: BenchmarkKind) -> Vec<&'static str> {
-    if kind.is_reconstruction() {
-        reconstruction_methods::method_names()
-    } else {
+    if !kind.is_reconstruction() {
         let mut names = methods::preset_names();
         names.extend(reference::names());
-        names
+        return names;
     }
+    let elementwise = kind == BenchmarkKind::Elementwise;
+    reconstruction_methods::methods()
+        .iter()
+        .filter(|m| m.is_elementwise() == elementwise)
+        .map(|m| m.name)
+        .collect()
 }
 
 /// The kind of a key of `params` or `matrix`: a parameter of the benchmark or the method.
@@ -223,6 +228,13 @@ mod tests {
         assert_eq!(ok, Ok(ParamValue::Str("shepard".into())));
         let e = normalize(kind, &node("mpm"), "params.method").unwrap_err();
         assert!(e.valid.contains(&"imls_quadratic".to_string()), "{e}");
+        let e = normalize(kind, &node("tls_fixed"), "params.method").unwrap_err();
+        assert!(!e.valid.contains(&"tls_fixed".to_string()), "{e}");
+        let elements = ValueKind::Method(BenchmarkKind::Elementwise);
+        let ok = normalize(elements, &node("tls_fitted"), "params.method");
+        assert_eq!(ok, Ok(ParamValue::Str("tls_fitted".into())));
+        let e = normalize(elements, &node("shepard"), "params.method").unwrap_err();
+        assert_eq!(e.valid, ["tls_fixed", "tls_fitted"]);
     }
 
     #[test]

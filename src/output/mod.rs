@@ -22,6 +22,10 @@ pub const REFERENCE_NORM: &str = "reference";
 pub const RECONSTRUCTION_FIELDS: [&str; 1] = ["u"];
 /// Its norms: `l2 = sqrt(sum_e h e_e^2)` (Gong sec 5.2), `max = max_e |e_e|`.
 pub const RECONSTRUCTION_NORMS: [&str; 2] = ["l2", "max"];
+/// The norms of an element-wise reconstruction, u - u^h at the Gauss points (Wobbes sec 2.1):
+/// `rms = sqrt(sum_g e_g^2 / Ng)` and `integral`, the relative error of the Gauss integral of
+/// u^h against the exact integral of u.
+pub const ELEMENT_NORMS: [&str; 2] = ["rms", "integral"];
 
 /// The error fields a kind of run reports, each in each of the norms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,16 +36,19 @@ pub struct Measures {
 
 impl Measures {
     pub fn of(kind: BenchmarkKind) -> Measures {
-        if kind.is_reconstruction() {
-            Measures {
-                fields: &RECONSTRUCTION_FIELDS,
-                norms: &RECONSTRUCTION_NORMS,
-            }
-        } else {
-            Measures {
+        match kind {
+            BenchmarkKind::Simulation => Measures {
                 fields: &ERROR_FIELDS,
                 norms: &NORMS,
-            }
+            },
+            BenchmarkKind::Reconstruction | BenchmarkKind::OrthogonalBasis => Measures {
+                fields: &RECONSTRUCTION_FIELDS,
+                norms: &RECONSTRUCTION_NORMS,
+            },
+            BenchmarkKind::Elementwise => Measures {
+                fields: &RECONSTRUCTION_FIELDS,
+                norms: &ELEMENT_NORMS,
+            },
         }
     }
 
@@ -108,6 +115,8 @@ pub struct RunSummary {
     pub final_norms: BTreeMap<(String, String), f64>,
     /// The `/reconstruction` group of a reconstruction run, which its figures and tables show.
     pub reconstruction: Option<ReconstructionRecord>,
+    /// The `/elements` group of an element-wise reconstruction run, likewise.
+    pub elements: Option<ElementRecord>,
     /// The l2 velocity error at every sample of a simulation run that took any.
     pub velocity_history: Option<VelocityHistory>,
     /// The state at the last sample of a 1D simulation run, when the report compares runs
@@ -155,12 +164,14 @@ pub struct VelocityHistory {
 }
 
 mod atomic;
+mod elements;
 mod reader;
 mod reconstruction;
 mod record;
 mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
+pub use elements::ElementRecord;
 pub use reader::{read_profile, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{

@@ -5,13 +5,14 @@ use hdf5::types::{TypeDescriptor, VarLenUnicode};
 use hdf5::Location;
 use ndarray::s;
 
-use super::{reconstruction, Profile, RunStatus, RunSummary, VelocityHistory};
-use super::{ERROR_FIELDS, NORMS};
-use super::{RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
+use super::{
+    elements, reconstruction, Profile, RunStatus, RunSummary, VelocityHistory, ERROR_FIELDS, NORMS,
+};
+use super::{ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
 use crate::params::{ParamValue, Params};
 
-/// Reads what the report needs from one run file. A reconstruction run has no time steps:
-/// its `steps` is 0 and its `dt` NaN.
+/// Reads what the report needs from one run file. A reconstruction run (nodal or element-wise)
+/// has no time steps: its `steps` is 0 and its `dt` NaN.
 pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let context = |e: hdf5::Error| format!("{}: {e}", path.display());
     let file = hdf5::File::open(path).map_err(context)?;
@@ -19,9 +20,21 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let status = RunStatus::parse(&status_text)
         .ok_or_else(|| format!("{}: unknown status '{status_text}'", path.display()))?;
     let reconstruction = reconstruction::read(&file).map_err(context)?;
-    let (final_norms, steps, dt, velocity_history) = match &reconstruction {
-        Some(r) => (reconstruction_norms(r.l2, r.max), 0, f64::NAN, None),
-        None => (
+    let elements = elements::read(&file).map_err(context)?;
+    let (final_norms, steps, dt, velocity_history) = match (&reconstruction, &elements) {
+        (Some(r), _) => (
+            unstepped_norms(&RECONSTRUCTION_NORMS, [r.l2, r.max]),
+            0,
+            f64::NAN,
+            None,
+        ),
+        (None, Some(r)) => (
+            unstepped_norms(&ELEMENT_NORMS, [r.rms, r.integral_error]),
+            0,
+            f64::NAN,
+            None,
+        ),
+        (None, None) => (
             simulation_norms(&file).map_err(context)?,
             read_i64(&file, "steps").map_err(context)? as usize,
             read_f64(&file, "dt").map_err(context)?,
@@ -46,6 +59,7 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         axes: read_params(&matrix).map_err(context)?,
         final_norms,
         reconstruction,
+        elements,
         velocity_history,
         profile: None,
     })
@@ -125,11 +139,12 @@ fn simulation_norms(file: &hdf5::File) -> hdf5::Result<FinalNorms> {
     Ok(final_norms)
 }
 
-fn reconstruction_norms(l2: f64, max: f64) -> FinalNorms {
+/// The error of u in each of the norms of a run that does not step.
+fn unstepped_norms(norms: &[&str; 2], values: [f64; 2]) -> FinalNorms {
     let [field] = RECONSTRUCTION_FIELDS;
-    RECONSTRUCTION_NORMS
-        .into_iter()
-        .zip([l2, max])
+    norms
+        .iter()
+        .zip(values)
         .map(|(norm, value)| ((field.to_string(), norm.to_string()), value))
         .collect()
 }

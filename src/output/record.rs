@@ -1,4 +1,4 @@
-use super::{ReconstructionRecord, RunStatus};
+use super::{ElementRecord, ReconstructionRecord, RunStatus};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
@@ -26,6 +26,8 @@ pub struct RunRecord {
     pub diagnostics: Diagnostics,
     /// Set for the runs of reconstruction benchmarks, which have no particles or history.
     pub reconstruction: Option<ReconstructionRecord>,
+    /// Set instead for the runs of the element-wise reconstruction benchmark.
+    pub elements: Option<ElementRecord>,
 }
 
 /// The root attributes `shape`, `transfer` and `integrator`: what the run's method is made of.

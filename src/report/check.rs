@@ -27,8 +27,8 @@ impl fmt::Display for CheckFailure {
 /// Evaluates every `expect` entry; an empty vector means all passed.
 ///
 /// Rate bounds apply to every fitted rate whose group matches the selector, and fail when
-/// none does. `error_max` applies to every run whose axes match the selector (the
-/// refinement axis included): each must have finished with a final error within the bound.
+/// none does. `error_min` and `error_max` apply to every run whose axes match the selector
+/// (the refinement axis included): each must have finished with a final error within them.
 /// A limit bound applies to every group of the other axes along its swept axis.
 pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) -> Vec<CheckFailure> {
     experiment
@@ -60,6 +60,7 @@ pub fn describe(e: &Expectation) -> String {
     let bounds: Vec<String> = [
         e.rate_min.map(|v| format!("rate >= {}", exact(v))),
         e.rate_max.map(|v| format!("rate <= {}", exact(v))),
+        e.error_min.map(|v| format!("error >= {}", exact(v))),
         e.error_max.map(|v| format!("error <= {}", exact(v))),
     ]
     .into_iter()
@@ -104,9 +105,9 @@ fn check_rates(e: &Expectation, rates: &[RateRow]) -> Vec<String> {
 }
 
 fn check_errors(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
-    let Some(max) = e.error_max else {
+    if e.error_min.is_none() && e.error_max.is_none() {
         return Vec::new();
-    };
+    }
     let matching: Vec<&RunSummary> = ordered_runs(runs)
         .into_iter()
         .filter(|run| selects(&e.select, &run.axes))
@@ -120,13 +121,8 @@ fn check_errors(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
             let at = subject(&label(&run.axes), e);
             let error = run.final_norms.get(&(e.field.clone(), e.norm.clone()));
             match (run.status, error) {
-                (RunStatus::Ok, Some(&error)) if error <= max => None,
-                (RunStatus::Ok, Some(&error)) => Some(format!(
-                    "{at}: error {} > error_max {} (run {})",
-                    beside(error, max),
-                    exact(max),
-                    run.run_id
-                )),
+                (RunStatus::Ok, Some(&error)) => error_outside(error, e.error_min, e.error_max)
+                    .map(|bound| format!("{at}: error {bound} (run {})", run.run_id)),
                 (RunStatus::Ok, None) => Some(format!("{at}: no final error (run {})", run.run_id)),
                 (status, _) => Some(format!(
                     "{at}: run {} {}: {}",
@@ -137,6 +133,16 @@ fn check_errors(e: &Expectation, runs: &[RunSummary]) -> Vec<String> {
             }
         })
         .collect()
+}
+
+/// `value > error_max ...` or `value < error_min ...` when the error breaks a bound (NaN
+/// breaks both), else `None`.
+fn error_outside(error: f64, min: Option<f64>, max: Option<f64>) -> Option<String> {
+    if let Some(max) = max.filter(|&max| error > max || error.is_nan()) {
+        return Some(format!("{} > error_max {}", beside(error, max), exact(max)));
+    }
+    let min = min.filter(|&min| error < min || error.is_nan())?;
+    Some(format!("{} < error_min {}", beside(error, min), exact(min)))
 }
 
 /// In every group of the selected runs, the last stable value of the swept axis must be at
@@ -202,6 +208,21 @@ fn beside(value: f64, bound: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn errors_outside_either_bound() {
+        assert_eq!(error_outside(6.17e-3, Some(6.165e-3), Some(6.175e-3)), None);
+        assert_eq!(
+            error_outside(6.2e-3, Some(6.165e-3), Some(6.175e-3)).unwrap(),
+            "0.0062 > error_max 0.006175"
+        );
+        assert_eq!(
+            error_outside(6.1e-3, Some(6.165e-3), None).unwrap(),
+            "0.0061 < error_min 0.006165"
+        );
+        assert!(error_outside(f64::NAN, Some(1.0), None).is_some());
+        assert!(error_outside(f64::NAN, None, Some(1.0)).is_some());
+    }
 
     #[test]
     fn values_near_a_bound_get_more_digits() {

@@ -1,13 +1,13 @@
 //! The tables that experiments ask for: u - u^h at the nodes in Gong's format (Tables
-//! 4.1-4.2), the <p_i, p_i> of the orthogonal basis (Tran Figs 1-3), and measured stability
-//! limits (`stability`). They go into report.md; the numbers come from the run files
-//! unchanged.
+//! 4.1-4.2), the <p_i, p_i> of the orthogonal basis (Tran Figs 1-3), the errors of the
+//! element-wise fits (Wobbes sec 2.1), and measured stability limits (`stability`). They go
+//! into report.md; the numbers come from the run files unchanged.
 
 use super::format::general;
 use super::group::{group_runs, label, selects, title_suffix};
 use super::stability;
 use crate::experiment::{Experiment, TableKind, TableSpec};
-use crate::output::{ReconstructionRecord, RunSummary};
+use crate::output::{ElementRecord, ReconstructionRecord, RunSummary};
 
 /// A table with a heading and a note on how to read it.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +27,7 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
             TableKind::NodalErrors => tables.extend(nodal_errors(experiment, selected, spec)),
             TableKind::BasisNorms => tables.extend(basis_norms(selected)),
             TableKind::Stability => tables.extend(stability::tables(selected, spec)),
+            TableKind::ElementFits => tables.extend(element_fits(experiment, selected)),
         }
     }
     tables
@@ -115,6 +116,64 @@ fn basis_norms<'a>(runs: impl Iterator<Item = &'a RunSummary>) -> Option<Table> 
         title: "Weighted orthogonal polynomials (Tran eq 16)".into(),
         note: "<p_i,p_i> = sum_p w(x_p - centre) p_i(x_p)^2; a polynomial is dropped (eq 17) when \
                this is at most 1e-10 of the weighted norm of its monomial, i.e. zero up to rounding."
+            .into(),
+        header,
+        rows,
+    })
+}
+
+/// One row per element-wise run in the order of the experiment: its axes, the RMS error and
+/// the integrals at the Gauss points, and how many elements fell below the requested degree.
+fn element_fits<'a>(
+    experiment: &Experiment,
+    runs: impl Iterator<Item = &'a RunSummary>,
+) -> Option<Table> {
+    let order = |run: &RunSummary| experiment.runs.iter().position(|r| r.run_id == run.run_id);
+    let mut rows: Vec<(&RunSummary, &ElementRecord)> = runs
+        .filter_map(|run| Some((run, run.elements.as_ref()?)))
+        .collect();
+    if rows.is_empty() {
+        return None;
+    }
+    rows.sort_by_key(|(run, _)| order(run));
+    let header = [
+        "run",
+        "u",
+        "a_1",
+        "Gauss points",
+        "RMS error",
+        "integral of u^h",
+        "exact integral",
+        "relative integral error",
+        "elements below the degree",
+    ]
+    .map(String::from)
+    .to_vec();
+    let rows = rows
+        .into_iter()
+        .map(|(run, r)| {
+            let elements = r.element_degree.len();
+            let points = r.gauss.pow(r.dim as u32);
+            vec![
+                label(&run.axes),
+                r.formula.clone(),
+                r.conservation.clone(),
+                format!("{points} per element"),
+                general(r.rms, 5),
+                general(r.integral, 10),
+                general(r.exact_integral, 10),
+                general(r.integral_error, 5),
+                format!("{} of {elements} (degree {})", r.degraded, r.degree),
+            ]
+        })
+        .collect();
+    Some(Table {
+        title: "Element-wise Taylor least squares (Wobbes sec 2.1)".into(),
+        note: "RMS = sqrt(mean of (u - u^h)^2 over the Gauss points of every element); the \
+               integral of u^h is the Gauss sum over the elements, its error relative to the exact \
+               integral of u. a_1 fixed is the exact element mean (eq 5), fitted is least squares. \
+               An element below the degree had data that could not support every Taylor \
+               function of it, and its fit dropped the whole degree."
             .into(),
         header,
         rows,

@@ -280,6 +280,7 @@ mod tests {
             axes: Params::from([("cfl".to_string(), ParamValue::Float(cfl))]),
             final_norms: BTreeMap::new(),
             reconstruction: None,
+            elements: None,
             velocity_history: Some(VelocityHistory {
                 time: (0..errors.len()).map(|k| k as f64).collect(),
                 l2_error: errors.to_vec(),

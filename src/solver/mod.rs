@@ -411,5 +411,6 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         conservation: Default::default(),
         diagnostics: Default::default(),
         reconstruction: None,
+        elements: None,
     }
 }

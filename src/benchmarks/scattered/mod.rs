@@ -5,12 +5,18 @@
 //!   (Gong sec 4.3.1, Tables 4.1-4.2; sec 5.2, Figs 5.1-5.4).
 //! * `recon1d_basis`: points given in the experiment file; besides the reconstruction, the
 //!   weighted orthogonal polynomials of eq 16 at a centre are recorded (Tran Figs 1-3).
+//! * `recon_tls`: points placed element by element in 1D or 2D, each element reconstructed
+//!   on its own (Wobbes et al. 2018, Figs 1-2; `elements`).
 
+mod elements;
 mod functions;
 mod points;
 
-pub use functions::TestFunction;
+pub use elements::{ElementData, ElementProblem, INFO as INFO_ELEMENTS};
+pub use functions::{ElementFunction, ExactField, SurfaceFunction, TestFunction};
 pub use points::{place, Spacing};
+
+use points::check_ppc;
 
 use super::{BenchmarkInfo, BenchmarkKind, Domain, ParamDefault, ParamKind, ParamSpec};
 use crate::params::{get_f64, get_list, get_str, get_usize, ParamError, Params};
@@ -135,6 +141,7 @@ pub(super) fn kind(name: &str) -> Option<BenchmarkKind> {
     match name {
         n if n == INFO_NODES.name => Some(BenchmarkKind::Reconstruction),
         n if n == INFO_BASIS.name => Some(BenchmarkKind::OrthogonalBasis),
+        n if n == INFO_ELEMENTS.name => Some(BenchmarkKind::Elementwise),
         _ => None,
     }
 }
@@ -162,16 +169,16 @@ impl ScatteredData {
                 get_list(params, "points")?.to_vec(),
                 Some(get_f64(params, "centre")?),
             ),
-            Some(_) => {
+            Some(BenchmarkKind::Reconstruction) => {
                 let spacing = choice(params, "spacing", Spacing::from_name)?;
                 let seed = get_usize(params, "seed")? as u64;
                 let ppc = get_usize(params, "ppc")?;
                 (place(spacing, lower, h, cells, ppc, seed), None)
             }
-            None => {
+            _ => {
                 return Err(ParamError::new(
                     "benchmark",
-                    format!("'{benchmark}' is not a reconstruction benchmark"),
+                    format!("'{benchmark}' is not a nodal reconstruction benchmark"),
                 ))
             }
         };
@@ -207,8 +214,15 @@ fn interval(params: &Params) -> Result<(f64, f64), ParamError> {
     }
 }
 
-/// The interval is not empty and the weight's support fits the reconstruction's node table.
+/// As `check_support`, and a placement has the points it needs per cell.
 fn check_nodes(params: &Params) -> Result<(), ParamError> {
+    check_support(params)?;
+    let spacing = choice(params, "spacing", Spacing::from_name)?;
+    check_ppc(spacing, get_usize(params, "ppc")?)
+}
+
+/// The interval is not empty and the weight's support fits the reconstruction's node table.
+fn check_support(params: &Params) -> Result<(), ParamError> {
     interval(params)?;
     let weight = choice(params, "weight", Weight::from_name)?;
     let scale = get_f64(params, "scale")?;
@@ -225,9 +239,9 @@ fn check_nodes(params: &Params) -> Result<(), ParamError> {
     Ok(())
 }
 
-/// As `check_nodes`, and the points and the centre lie in the interval.
+/// As `check_support`, and the points and the centre lie in the interval.
 fn check_basis(params: &Params) -> Result<(), ParamError> {
-    check_nodes(params)?;
+    check_support(params)?;
     let (lower, upper) = interval(params)?;
     let inside = |x: f64| (lower..=upper).contains(&x);
     if let Some(x) = get_list(params, "points")?.iter().find(|&&x| !inside(x)) {

@@ -106,7 +106,8 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
                 experiment, &selected, spec, &mut names,
             )),
             FigureKind::Reconstruction => {
-                figures.extend(profiles::reconstructions(experiment, &selected, &mut names))
+                figures.extend(profiles::reconstructions(experiment, &selected, &mut names));
+                figures.extend(profiles::element_fits(experiment, &selected, &mut names));
             }
             FigureKind::Basis => figures.extend(profiles::bases(experiment, &selected, &mut names)),
             FigureKind::Stability => figures.extend(stability::limit_figures(

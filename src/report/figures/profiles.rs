@@ -1,5 +1,6 @@
 //! Figures of one reconstruction run each: u with its reconstructed nodal values and the data
-//! (Gong Figs 4.1-4.6, 5.1-5.2), and the weighted orthogonal basis (Tran Figs 1-3).
+//! (Gong Figs 4.1-4.6, 5.1-5.2), u with each element's fit (Wobbes Figs 1-2), and the
+//! weighted orthogonal basis (Tran Figs 1-3).
 
 use super::{Figure, Marker, Names, Scale, Series};
 use crate::experiment::Experiment;
@@ -39,6 +40,81 @@ pub(super) fn reconstructions(
             series,
         }
     })
+}
+
+/// u as a line, each element's fit u^h as a line of its own (with the degree it settled on),
+/// and the data as squares: along x in 1D; in 2D along the line y = const through the middle
+/// of the middle row of elements, with the data on that line.
+pub(super) fn element_fits(
+    experiment: &Experiment,
+    runs: &[&RunSummary],
+    names: &mut Names,
+) -> Vec<Figure> {
+    runs.iter()
+        .filter_map(|run| {
+            let r = run.elements.as_ref()?;
+            let d = r.dim;
+            // The height of the samples in 2D; every sample of a 1D run is on the line.
+            let level = (d == 2).then(|| r.curve_x.get(1).copied()).flatten();
+            let on_line =
+                |x: &[f64]| level.is_none_or(|y| (x[1] - y).abs() <= 1e-12 * y.abs().max(1.0));
+            let curve: Vec<(f64, i64, f64, f64)> = (0..r.curve_exact.len())
+                .map(|c| {
+                    (
+                        r.curve_x[c * d],
+                        r.curve_element[c],
+                        r.curve_exact[c],
+                        r.curve_reconstructed[c],
+                    )
+                })
+                .collect();
+            let mut series = vec![Series::line(
+                format!("u = {}", r.formula),
+                curve.iter().map(|c| (c.0, c.2)).collect(),
+            )];
+            let mut elements: Vec<i64> = curve.iter().map(|c| c.1).collect();
+            elements.dedup();
+            for e in elements {
+                let k = e as usize;
+                let degree = r.element_degree.get(k).copied().unwrap_or_default();
+                let (a, b) = (r.lower[k * d], r.upper[k * d]);
+                series.push(Series::line(
+                    format!(
+                        "u^h on [{}, {}], degree {degree}",
+                        general(a, 4),
+                        general(b, 4)
+                    ),
+                    curve
+                        .iter()
+                        .filter(|c| c.1 == e)
+                        .map(|c| (c.0, c.3))
+                        .collect(),
+                ));
+            }
+            let data = r
+                .data_x
+                .chunks(d.max(1))
+                .zip(&r.data_u)
+                .filter(|(x, _)| on_line(x))
+                .map(|(x, &u)| (x[0], u))
+                .collect();
+            series.push(Series::markers("data points".into(), Marker::Square, data));
+            let elements = r.element_degree.len();
+            let at = match level {
+                Some(y) => format!(" at y = {}", general(y, 4)),
+                None => String::new(),
+            };
+            Some(Figure {
+                file: names.file(experiment, &format!("elements_{}", label(&run.axes))),
+                title: format!("{}: u = {}{at}, {elements} elements", run.method, r.formula),
+                x_label: "x".into(),
+                y_label: "u".into(),
+                scale: Scale::Linear,
+                series,
+            })
+        })
+        .filter(|figure| figure.series.iter().any(|s| !s.line.is_empty()))
+        .collect()
 }
 
 /// p_1 .. p_m as lines with the data points on them; a dropped polynomial says so.

@@ -1,27 +1,41 @@
 //! One run of a reconstruction benchmark: place the data, fit the method's local least
 //! squares at the grid nodes, and record u - u^h there; for `recon1d_basis` also the weighted
-//! orthogonal basis. No time stepping.
+//! orthogonal basis. The element-wise benchmark fits each element instead (`elements`). No
+//! time stepping.
 
 mod basis;
+mod elements;
 
 use nalgebra::SVector;
 
 use super::base_record;
-use crate::benchmarks::scattered::ScatteredData;
+use crate::benchmarks::scattered::{ElementProblem, ScatteredData};
+use crate::benchmarks::{self, BenchmarkKind};
 use crate::experiment::RunSpec;
-use crate::output::{ReconstructionRecord, RunRecord, RunStatus};
-use crate::reconstruct::{Kernel, Lattice, Recipe, Reconstructor};
-use crate::reconstruction_methods::{self, ReconstructionMethod};
+use crate::output::{ElementRecord, ReconstructionRecord, RunRecord, RunStatus};
+use crate::reconstruct::{Kernel, Lattice, Recipe, Reconstructor, Solver};
+use crate::reconstruction_methods::{self, Fit, ReconstructionMethod};
 use crate::shape::Grid;
 
 /// Samples of u on the interval for plots: smooth enough for sin(pi x) at any scale.
 const CURVE_SAMPLES: usize = 401;
 
-/// Runs one configuration. A run whose method cannot be fitted (a singular MLS moment matrix)
-/// is `failed`, with the evaluation point in `message` and the data still recorded.
+/// Runs one configuration, nodal or element-wise by the benchmark's kind.
 pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
+    let elementwise = benchmarks::info(&spec.benchmark)
+        .is_some_and(|info| benchmarks::kind(info) == BenchmarkKind::Elementwise);
+    if elementwise {
+        evaluate_elements(spec)
+    } else {
+        evaluate_nodes(spec)
+    }
+}
+
+/// A nodal reconstruction. A run whose method cannot be fitted (a singular MLS moment matrix)
+/// is `failed`, with the evaluation point in `message` and the data still recorded.
+fn evaluate_nodes(spec: &RunSpec) -> RunRecord {
     let mut record = base_record(spec, String::new());
-    let (data, method) = match prepare(spec) {
+    let (data, method, solver) = match prepare(spec) {
         Ok(prepared) => prepared,
         Err(message) => {
             record.message = message;
@@ -35,8 +49,8 @@ pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
     };
     let grid = Grid::new(&data.domain);
     record.h = grid.h;
-    let mut out = describe(&data, method);
-    match fit_nodes(&data, method, &grid, &mut out) {
+    let mut out = describe(&data, method, solver);
+    match fit_nodes(&data, method, solver, &grid, &mut out) {
         Ok(()) => record.status = RunStatus::Ok,
         Err(message) => record.message = message,
     }
@@ -47,22 +61,81 @@ pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
     record
 }
 
-fn prepare(spec: &RunSpec) -> Result<(ScatteredData, &'static ReconstructionMethod), String> {
-    let method = reconstruction_methods::method(&spec.method).ok_or_else(|| {
+fn prepare(
+    spec: &RunSpec,
+) -> Result<(ScatteredData, &'static ReconstructionMethod, Solver), String> {
+    let method = reconstruction_method(spec)?;
+    let Fit::Local(solver) = method.fit else {
+        return Err(format!(
+            "'{}' fits element by element; a nodal benchmark needs a local method",
+            method.name
+        ));
+    };
+    let data =
+        ScatteredData::from_params(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
+    Ok((data, method, solver))
+}
+
+fn reconstruction_method(spec: &RunSpec) -> Result<&'static ReconstructionMethod, String> {
+    reconstruction_methods::method(&spec.method).ok_or_else(|| {
         format!(
             "unknown reconstruction method '{}'; valid: {}",
             spec.method,
             reconstruction_methods::method_names().join(", ")
         )
-    })?;
-    let data =
-        ScatteredData::from_params(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
-    Ok((data, method))
+    })
+}
+
+/// An element-wise reconstruction: every element fitted on its own, errors at Gauss points.
+/// A run that cannot start is `failed` with the reason in `message`.
+fn evaluate_elements(spec: &RunSpec) -> RunRecord {
+    let mut record = base_record(spec, String::new());
+    let fitted = reconstruction_method(spec).and_then(|method| {
+        let Fit::Taylor(conservation) = method.fit else {
+            return Err(format!(
+                "'{}' is a local fit; the element-wise benchmark needs a tls method",
+                method.name
+            ));
+        };
+        let problem = ElementProblem::from_params(&spec.params).map_err(|e| e.to_string())?;
+        let degree = method.degree.value();
+        Ok(match problem {
+            ElementProblem::Line(data) => {
+                (data.h(), elements::reconstruct(&data, degree, conservation))
+            }
+            ElementProblem::Surface(data) => {
+                (data.h(), elements::reconstruct(&data, degree, conservation))
+            }
+        })
+    });
+    match fitted {
+        Ok((h, out)) => {
+            record.status = RunStatus::Ok;
+            record.dim = out.dim;
+            record.h = h;
+            record.elements = Some(out);
+        }
+        Err(message) => {
+            record.message = message;
+            record.elements = Some(ElementRecord {
+                rms: f64::NAN,
+                integral: f64::NAN,
+                exact_integral: f64::NAN,
+                integral_error: f64::NAN,
+                ..Default::default()
+            });
+        }
+    }
+    record
 }
 
 /// The record before the fit: the method, the data and the exact values; the fit's outputs
 /// are NaN until `fit_nodes` fills them.
-fn describe(data: &ScatteredData, method: &ReconstructionMethod) -> ReconstructionRecord {
+fn describe(
+    data: &ScatteredData,
+    method: &ReconstructionMethod,
+    solver: Solver,
+) -> ReconstructionRecord {
     let u = |xs: &[f64]| {
         xs.iter()
             .map(|&x| data.function.eval(x))
@@ -81,7 +154,7 @@ fn describe(data: &ScatteredData, method: &ReconstructionMethod) -> Reconstructi
         weight: data.weight.name().to_string(),
         scale: data.scale,
         degree: method.degree.value() as i64,
-        solver: method.solver.to_string(),
+        solver: solver.to_string(),
         exact: u(&x),
         reconstructed: vec![f64::NAN; nodes],
         error: vec![f64::NAN; nodes],
@@ -104,6 +177,7 @@ fn describe(data: &ScatteredData, method: &ReconstructionMethod) -> Reconstructi
 fn fit_nodes(
     data: &ScatteredData,
     method: &ReconstructionMethod,
+    solver: Solver,
     grid: &Grid<1>,
     out: &mut ReconstructionRecord,
 ) -> Result<(), String> {
@@ -113,7 +187,7 @@ fn fit_nodes(
             scale: data.scale,
         },
         degree: method.degree,
-        solver: method.solver,
+        solver,
     };
     let mut reconstructor = Reconstructor::new(recipe, Lattice::nodes(grid));
     let positions: Vec<SVector<f64, 1>> = data.points.iter().map(|&x| [x].into()).collect();
