@@ -102,6 +102,12 @@ const TLS: TaylorRecipe = TaylorRecipe {
     mass: MassMatrix::Consistent,
 };
 
+/// TLS with the lumped mass matrix, which sec 3 allows without losing conservation.
+const TLS_LUMPED: TaylorRecipe = TaylorRecipe {
+    mass: MassMatrix::Lumped,
+    ..TLS
+};
+
 const fn on_domains(
     shape: DomainShape,
     transfer: TransferKind,
@@ -181,13 +187,7 @@ const PRESETS: &[MethodPreset] = &[
     },
     MethodPreset {
         name: "mpm_tls_lumped",
-        method: musl_on(
-            ShapeKind::Linear,
-            TransferKind::Taylor(TaylorRecipe {
-                mass: MassMatrix::Lumped,
-                ..TLS
-            }),
-        ),
+        method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS_LUMPED)),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
         description: "MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
     },
@@ -274,6 +274,13 @@ const PRESETS: &[MethodPreset] = &[
         method: musl_on(ShapeKind::DualDomain, TransferKind::Taylor(TLS)),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
         description: "dual-domain MPM with the conservative TLS mapping, MUSL",
+    },
+    MethodPreset {
+        name: "ddmpm_tls_lumped",
+        method: musl_on(ShapeKind::DualDomain, TransferKind::Taylor(TLS_LUMPED)),
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+        description:
+            "dual-domain MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
     },
 ];
 

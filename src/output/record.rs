@@ -130,4 +130,6 @@ pub struct Diagnostics {
     pub reconstructions: usize,
     /// Fits whose moment matrix lost rank.
     pub rank_deficient: usize,
+    /// Particle moves from one grid cell to another, summed over the steps.
+    pub grid_crossings: usize,
 }

@@ -80,6 +80,7 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     for (name, value) in [
         ("reconstructions", r.diagnostics.reconstructions),
         ("rank_deficient", r.diagnostics.rank_deficient),
+        ("grid_crossings", r.diagnostics.grid_crossings),
     ] {
         attr_i64(&diagnostics, name, value as i64)?;
     }

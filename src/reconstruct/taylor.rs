@@ -185,8 +185,14 @@ impl<const D: usize> TaylorFit<D> {
         points: &[SVector<f64, D>],
     ) -> usize {
         assert!(!points.is_empty(), "a Taylor fit needs at least one point");
-        let requested = degree.min(2);
         let prescribed = conservation.prescribed();
+        // More unknowns than points never have full rank, but rounding in the moments can
+        // hide that when the points are nearly dependent (a deformed 2 x 2 lattice in 2D
+        // passed the rank test with five quadratic unknowns), so count first.
+        let mut requested = degree.min(2);
+        while requested > 0 && taylor_terms(D, requested) - prescribed > points.len() {
+            requested -= 1;
+        }
         let terms = taylor_terms(D, requested);
         self.psi.clear();
         self.psi

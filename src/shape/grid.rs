@@ -117,6 +117,14 @@ impl<const D: usize> Grid<D> {
         Some((cell, xi))
     }
 
+    /// Flat index of the cell with integer coordinates `cell` (first axis fastest).
+    #[inline]
+    pub fn cell_index(&self, cell: [usize; D]) -> usize {
+        cell.iter()
+            .rev()
+            .fold(0, |index, &c| index * self.cells + c)
+    }
+
     #[inline]
     pub fn inv_h(&self) -> f64 {
         self.inv_h

@@ -110,6 +110,9 @@ struct Run<'a, const D: usize> {
     /// Nodal velocity rebuilt after the particles moved (MUSL only).
     remapped: Vec<SVector<f64, D>>,
     fits: FitStats,
+    /// The cell of every particle after the last step, to count grid crossings.
+    cells: Vec<usize>,
+    grid_crossings: usize,
     recorder: Recorder,
 }
 
@@ -154,6 +157,8 @@ impl<'a, const D: usize> Run<'a, D> {
             fixed,
             body_force: vec![SVector::zeros(); n],
             fits: FitStats::default(),
+            cells: Vec::new(),
+            grid_crossings: 0,
             recorder: Recorder::new(),
             problem,
         }
@@ -175,6 +180,7 @@ impl<'a, const D: usize> Run<'a, D> {
                 diagnostics: Diagnostics {
                     reconstructions: self.fits.fits,
                     rank_deficient: self.fits.rank_deficient,
+                    grid_crossings: self.grid_crossings,
                 },
             },
         )
@@ -190,6 +196,7 @@ impl<'a, const D: usize> Run<'a, D> {
         if let Err(reason) = self.update_stencils() {
             return (0, Err((0, reason)));
         }
+        self.cells = self.particles.x.iter().map(|x| self.cell_of(x)).collect();
         for s in 0..=steps {
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
@@ -241,8 +248,28 @@ impl<'a, const D: usize> Run<'a, D> {
             {
                 return (s, Err((s + 1, reason)));
             }
+            self.count_grid_crossings();
         }
         (steps, Ok(()))
+    }
+
+    /// Flat index of the cell holding `x`, which the stencils found inside the grid.
+    fn cell_of(&self, x: &SVector<f64, D>) -> usize {
+        self.grid
+            .locate(x)
+            .map_or(usize::MAX, |(cell, _)| self.grid.cell_index(cell))
+    }
+
+    /// Adds the particles that changed cell in the last step (Wobbes et al. sec 5 count them
+    /// to explain MPM's grid-crossing error).
+    fn count_grid_crossings(&mut self) {
+        for p in 0..self.cells.len() {
+            let cell = self.cell_of(&self.particles.x[p]);
+            if cell != self.cells[p] {
+                self.cells[p] = cell;
+                self.grid_crossings += 1;
+            }
+        }
     }
 
     /// Records how far the totals the last mapping gave the DOFs are from the particles'.
@@ -273,7 +300,7 @@ impl<'a, const D: usize> Run<'a, D> {
                 .update(&QuadraticBSpline, &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
             Basis::DualDomain(dual) => {
-                dual.integrate(&self.grid, &self.particles.x, &self.particles.volume)
+                dual.integrate(&self.grid, &self.particles.x)
                     .and_then(|()| self.stencils.update(dual, &self.grid, &self.particles.x))
                     .map_err(|particle| Divergence::LeftGrid { particle })?;
                 self.transfer.refresh_basis(dual);

@@ -64,8 +64,9 @@ REFERENCE_METHODS = ("ulfem",)
 # Methods whose mappings conserve mass and momentum to round-off.
 CONSERVATIVE_METHODS = (
     "mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped", "bsmpm", "bsmpm_tls", "ddmpm", "ddmpm_tls",
+    "ddmpm_tls_lumped",
 )
-DIAGNOSTICS = ("reconstructions", "rank_deficient")
+DIAGNOSTICS = ("reconstructions", "rank_deficient", "grid_crossings")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
 

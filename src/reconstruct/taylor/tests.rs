@@ -337,3 +337,27 @@ fn crowded_points_are_solved_as_accurately_as_by_an_orthogonal_factorisation() {
         );
     }
 }
+
+/// Four points of a slightly deformed 2 x 2 lattice (MPM's 2 points per cell and axis) cannot
+/// carry the five or six quadratic unknowns, however rounding makes the last of them look.
+#[test]
+fn more_unknowns_than_points_lower_the_degree() {
+    let cell = TaylorCell::<2>::new([0.0, 0.0].into(), [1.0, 1.0].into());
+    let mut rng = Lcg::new(29);
+    let mut fit = TaylorFit::<2>::default();
+    for strain in [0.0, 1e-4, 1e-3, 1e-2, 5e-2] {
+        let points: Vec<SVector<f64, 2>> = [[0.25, 0.25], [0.75, 0.25], [0.25, 0.75], [0.75, 0.75]]
+            .map(|[x, y]| {
+                let mut jitter = |_: usize| strain * (rng.unit() - 0.5);
+                SVector::from([x + jitter(0), y + jitter(1)])
+            })
+            .to_vec();
+        for conservation in [Conservation::Fixed, Conservation::Fitted] {
+            assert_eq!(
+                fit.factor(&cell, 2, conservation, &points),
+                1,
+                "strain {strain}, {conservation:?}"
+            );
+        }
+    }
+}
