@@ -1,5 +1,6 @@
-//! Stencils over a block of `NODES_PER_AXIS` grid nodes per axis, shared by the shapes whose
-//! support at a point is wider than one cell (particle domains, the dual-domain gradient).
+//! Stencils over a block of grid nodes per axis, shared by the shapes whose support at a point
+//! is wider than one cell: `NODES_PER_AXIS` for particle domains and the dual-domain gradient,
+//! as many as the cut-off radius spans for local maximum entropy.
 
 use nalgebra::SVector;
 
@@ -9,9 +10,9 @@ use super::Grid;
 /// dual-domain gradient reaches one node beyond the point's cell on each side.
 pub const NODES_PER_AXIS: usize = 4;
 
-/// The first block start along each axis that keeps the block inside the grid.
-fn last_start<const D: usize>(grid: &Grid<D>) -> usize {
-    grid.cells.saturating_sub(NODES_PER_AXIS - 1)
+/// The first block start along each axis that keeps a block of `per_axis` nodes inside the grid.
+fn last_start<const D: usize>(grid: &Grid<D>, per_axis: usize) -> usize {
+    grid.cells.saturating_sub(per_axis - 1)
 }
 
 /// The first node of the stencil block along each axis for a bounding box [lo, hi] (in cell
@@ -21,7 +22,7 @@ pub fn block_start<const D: usize>(
     lo: &SVector<f64, D>,
     hi: &SVector<f64, D>,
 ) -> Option<[usize; D]> {
-    let last_start = last_start(grid);
+    let last_start = last_start(grid, NODES_PER_AXIS);
     let mut start = [0; D];
     for k in 0..D {
         start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
@@ -35,24 +36,38 @@ pub fn block_start<const D: usize>(
 /// The first node of the block around `cell`: its nodes and one more on each side, the block
 /// shifted inwards where the grid ends.
 pub fn block_around_cell<const D: usize>(grid: &Grid<D>, cell: &[usize; D]) -> [usize; D] {
-    let last_start = last_start(grid);
+    let last_start = last_start(grid, NODES_PER_AXIS);
     std::array::from_fn(|k| cell[k].saturating_sub(1).min(last_start))
 }
 
-/// Node index of entry `e` of a stencil block starting at `start`: the block's first axis
-/// runs fastest. Entries past the grid (grids with fewer than three cells) repeat the last node
-/// and must carry zero weight.
+/// The first node of a block of `per_axis` nodes per axis that holds every node from `lo` (in
+/// cell units from the grid's lower corner) to `per_axis - 1` cells beyond it, shifted inwards
+/// where the grid ends.
+pub fn block_from<const D: usize>(
+    grid: &Grid<D>,
+    lo: &SVector<f64, D>,
+    per_axis: usize,
+) -> [usize; D] {
+    let last_start = last_start(grid, per_axis);
+    std::array::from_fn(|k| (lo[k].ceil().max(0.0) as usize).min(last_start))
+}
+
+/// Node index of entry `e` of a stencil block of `per_axis` nodes per axis starting at `start`,
+/// and its coordinates within the block: the block's first axis runs fastest. Entries past the
+/// grid (grids with fewer than `per_axis - 1` cells) repeat the last node and must carry zero
+/// weight.
 pub fn block_node<const D: usize>(
     grid: &Grid<D>,
     start: &[usize; D],
+    per_axis: usize,
     e: usize,
 ) -> (usize, [usize; D]) {
     let mut index = 0;
     let mut local = [0; D];
     let mut rest = e;
     for k in 0..D {
-        local[k] = rest % NODES_PER_AXIS;
-        rest /= NODES_PER_AXIS;
+        local[k] = rest % per_axis;
+        rest /= per_axis;
         index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
     }
     (index, local)

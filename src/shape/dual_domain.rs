@@ -170,7 +170,7 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         }
         let start = block_around_cell(grid, &cell);
         for e in 0..node.len() {
-            node[e] = block_node(grid, &start, e).0 as u32;
+            node[e] = block_node(grid, &start, NODES_PER_AXIS, e).0 as u32;
         }
         weight.fill(0.0);
         grad.fill(SVector::zeros());

@@ -6,6 +6,7 @@ mod domain;
 mod dual_domain;
 mod grid;
 mod linear;
+mod lme;
 mod stencils;
 
 use nalgebra::SVector;
@@ -15,6 +16,9 @@ pub use domain::{DomainFault, DomainShape, ParticleDomains};
 pub use dual_domain::DualDomain;
 pub use grid::{lattice_coords, lattice_strides, Dofs, Grid};
 pub use linear::LinearHat;
+pub use lme::{
+    LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, RESIDUAL_TOLERANCE,
+};
 pub use stencils::Stencils;
 
 /// A family of grid basis functions N_i(x).

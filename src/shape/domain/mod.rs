@@ -247,7 +247,7 @@ fn fill_box<const D: usize>(
         averaged_hats(lo[k], hi[k], start[k], &mut value[k], &mut slope[k]);
     }
     for e in 0..node.len() {
-        let (index, local) = block_node(grid, &start, e);
+        let (index, local) = block_node(grid, &start, NODES_PER_AXIS, e);
         let mut w = 1.0;
         let mut g = SVector::<f64, D>::repeat(inv_h);
         for k in 0..D {
@@ -296,7 +296,7 @@ fn fill_corners<const D: usize>(
         }
     }
     for e in 0..node.len() {
-        let (index, at) = block_node(grid, &start, e);
+        let (index, at) = block_node(grid, &start, NODES_PER_AXIS, e);
         let mut w = 0.0;
         let mut g = SVector::<f64, D>::zeros();
         for a in 0..corners.len() {

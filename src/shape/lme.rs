@@ -1,0 +1,349 @@
+//! Local maximum-entropy (LME) shape functions (Arroyo & Ortiz 2006) on the nodes of the uniform
+//! grid, as Molinos et al. use them in MPM (sec 5, eqs 32-38).
+//!
+//! At a point x the weights are p_a = exp(f_a) / Z with f_a = -beta |x - x_a|^2 + lambda . (x - x_a)
+//! and Z = sum_a exp(f_a) (eqs 32, 33), beta = gamma / h^2. The multiplier lambda minimises
+//! log Z, whose gradient r = sum_a p_a (x - x_a) (eq 38) vanishes exactly when the weights
+//! reproduce x; its Hessian J = sum_a p_a (x - x_a)(x - x_a)^T - r r^T (eq 37) is the covariance
+//! of the offsets under p. Everything below works in the scaled offsets d_a = (x - x_a) / h, where
+//! f_a = -gamma |d_a|^2 + mu . d_a with mu = lambda h, so that r and J are O(1) whatever h.
+
+use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use nalgebra::{SMatrix, SVector};
+
+use super::block::{block_from, block_node};
+use super::{Dofs, Grid, Shape};
+
+/// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
+/// exp(-beta |x - x_a|^2) is below it are left out.
+pub const DEFAULT_TOLERANCE: f64 = 1e-6;
+
+/// Default Newton iteration limit. A point on a face of the grid needs 25-27 steps at
+/// gamma = 0.8 and 3: its multiplier is infinite (see `LocalMaxEnt`), and each step shrinks the
+/// weight off the face by a factor of about e.
+pub const MAX_ITERATIONS: usize = 100;
+
+/// Newton stops when |r| < RESIDUAL_TOLERANCE h, i.e. when sum_a p_a x_a reproduces x to that.
+pub const RESIDUAL_TOLERANCE: f64 = 1e-12;
+
+/// Sufficient-decrease factor of the Armijo test on log Z.
+const ARMIJO: f64 = 1e-4;
+
+/// Backtracking halves the step at most this often (to 2^-50 of the Newton step).
+const MAX_HALVINGS: usize = 50;
+
+/// Relative size of the round-off in log Z, a sum of exponents of up to gamma r^2 + |mu| r:
+/// near the solution the decrease of a Newton step falls below it, and the step is taken.
+const ROUNDOFF: f64 = 64.0 * f64::EPSILON;
+
+/// The LME basis with locality gamma = beta h^2 on a grid of `Dofs::Nodes` in `D` dimensions.
+///
+/// **Stencil.** The nodes a with exp(-gamma |d_a|^2) >= tolerance, i.e. within the cut-off
+/// radius r = h sqrt(-ln(tolerance) / gamma). Along each axis they lie among the
+/// floor(2 r / h) + 1 nodes from x - r on, so the stencil is that block (shifted inwards at the
+/// grid's ends); the selected nodes come first, the block's other entries carry zero weight and
+/// gradient. Nodes outside the grid do not exist, so near a boundary the weights live on the
+/// grid's nodes alone and keep the convex-hull property.
+///
+/// **Boundary.** On a face of the grid x is on the boundary of the nodes' convex hull: the
+/// minimiser of log Z is at infinity, the limit weights are the LME of the face's nodes, and
+/// Newton approaches it until the weight off the face is below the residual tolerance.
+///
+/// **Failures.** `evaluate` returns why Newton stopped short. `eval`, whose interface has no
+/// error channel, then fills the stencil from the last iterate (non-negative weights that sum to
+/// one, whose first moment misses x by the final residual, with their exact gradients, zero
+/// where J is singular) and adds one to `failures()`, which callers read after a pass; it never
+/// panics.
+#[derive(Debug)]
+pub struct LocalMaxEnt<const D: usize> {
+    gamma: f64,
+    /// The cut-off radius in units of h.
+    radius: f64,
+    /// Nodes per axis of the stencil block.
+    per_axis: usize,
+    /// Largest Newton step |Delta mu|. The weights are a Gaussian centred at d = mu / (2 gamma),
+    /// so the limit 2 gamma r / h moves the centre by at most the cut-off radius per step.
+    max_step: f64,
+    max_iterations: usize,
+    failures: AtomicUsize,
+}
+
+/// gamma and tolerance for which the LME problem has no solution at some point of the grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LmeParamError {
+    pub gamma: f64,
+    pub tolerance: f64,
+    pub dimension: usize,
+}
+
+impl fmt::Display for LmeParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "LME needs gamma > 0, 0 < tolerance < 1 and, in {}D, a cut-off radius \
+             sqrt(-ln(tolerance) / gamma) above {} h; gamma = {} and tolerance = {} give {} h",
+            self.dimension,
+            surround_radius(self.dimension),
+            self.gamma,
+            self.tolerance,
+            cut_off_radius(self.gamma, self.tolerance)
+        )
+    }
+}
+
+/// Why `LocalMaxEnt::evaluate` gave no converged basis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LmeFailure {
+    /// The point is outside the grid; nothing was filled.
+    Outside,
+    /// The iteration limit left |r| = `residual` h, at or above `RESIDUAL_TOLERANCE` h.
+    NotConverged { residual: f64 },
+    /// J was not positive definite, or no step along the Newton direction decreased log Z.
+    Stalled { residual: f64 },
+}
+
+/// The cut-off radius in units of h.
+fn cut_off_radius(gamma: f64, tolerance: f64) -> f64 {
+    (-tolerance.ln() / gamma).sqrt()
+}
+
+/// The smallest cut-off radius (in units of h) for which every point strictly inside the grid
+/// lies strictly inside the convex hull of its selected nodes: a point just off a cell face,
+/// midway along it, needs the nodes of the next layer, sqrt(1 + (D - 1) / 4) away.
+fn surround_radius(dimension: usize) -> f64 {
+    (1.0 + (dimension as f64 - 1.0) / 4.0).sqrt()
+}
+
+impl<const D: usize> LocalMaxEnt<D> {
+    /// The basis with the default cut-off tolerance.
+    pub fn new(gamma: f64) -> Result<Self, LmeParamError> {
+        Self::with_tolerance(gamma, DEFAULT_TOLERANCE)
+    }
+
+    /// The basis with cut-off `tolerance`; its radius must surround every point of a cell
+    /// (`surround_radius`), which bounds gamma by -ln(tolerance) in 1D and 0.8 (-ln(tolerance))
+    /// in 2D.
+    pub fn with_tolerance(gamma: f64, tolerance: f64) -> Result<Self, LmeParamError> {
+        let radius = cut_off_radius(gamma, tolerance);
+        let valid = gamma > 0.0
+            && tolerance > 0.0
+            && tolerance < 1.0
+            && radius.is_finite()
+            && radius > surround_radius(D);
+        if !valid {
+            return Err(LmeParamError {
+                gamma,
+                tolerance,
+                dimension: D,
+            });
+        }
+        Ok(LocalMaxEnt {
+            gamma,
+            radius,
+            per_axis: (2.0 * radius).floor() as usize + 1,
+            max_step: 2.0 * gamma * radius,
+            max_iterations: MAX_ITERATIONS,
+            failures: AtomicUsize::new(0),
+        })
+    }
+
+    /// The same basis with another Newton iteration limit.
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+
+    /// The cut-off radius in units of h.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// How many evaluations through `Shape::eval` did not converge.
+    pub fn failures(&self) -> usize {
+        self.failures.load(Ordering::Relaxed)
+    }
+
+    /// Fills the stencil of `x` as `Shape::eval` does; returns the number of Newton steps, or
+    /// why Newton stopped short (the stencil then holds the last iterate, see `LocalMaxEnt`).
+    pub fn evaluate(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> Result<usize, LmeFailure> {
+        debug_assert_eq!(grid.dofs(), Dofs::Nodes);
+        if grid.locate(x).is_none() {
+            return Err(LmeFailure::Outside);
+        }
+        let s = (x - grid.lower) * grid.inv_h();
+        let start = block_from(grid, &s.add_scalar(-self.radius), self.per_axis);
+        // The selected nodes go first, their offsets d_a held in `grad` until the gradients
+        // replace them; the others fill the stencil from the back.
+        let radius_squared = self.radius * self.radius;
+        let mut selected = 0;
+        let mut unused = node.len();
+        for e in 0..node.len() {
+            let (index, local) = block_node(grid, &start, self.per_axis, e);
+            let on_grid = (0..D).all(|k| start[k] + local[k] <= grid.cells);
+            let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
+            if on_grid && d.norm_squared() <= radius_squared {
+                node[selected] = index as u32;
+                grad[selected] = d;
+                selected += 1;
+            } else {
+                unused -= 1;
+                node[unused] = index as u32;
+                weight[unused] = 0.0;
+                grad[unused] = SVector::zeros();
+            }
+        }
+        let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
+        let (at, status) = self.solve(offsets, weights);
+        // Eq 36 with the offsets taken about their mean r: at r = 0 it is eq 36, and at any
+        // iterate it is the exact gradient of weights whose first moment misses x by the fixed
+        // r, so sum_a grad p_a = 0 and sum_a x_a (x) grad p_a = I hold to round-off.
+        let inverse = at.j.cholesky().map(|c| c.inverse());
+        for (g, p) in offsets.iter_mut().zip(weights.iter()) {
+            *g = match &inverse {
+                Some(inverse) => -(inverse * (*g - at.r)) * (p * grid.inv_h()),
+                None => SVector::zeros(),
+            };
+        }
+        status
+    }
+
+    /// Newton's method on log Z from mu = 0, leaving the weights of the last iterate in
+    /// `weight`: its moments, and the number of steps or why Newton stopped short.
+    fn solve(
+        &self,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> (Moments<D>, Result<usize, LmeFailure>) {
+        let mut mu = SVector::zeros();
+        let mut at = Moments::at(self.gamma, &mu, offsets, weight);
+        let mut steps = 0;
+        loop {
+            let residual = at.r.norm();
+            if residual < RESIDUAL_TOLERANCE {
+                return (at, Ok(steps));
+            }
+            if steps == self.max_iterations {
+                return (at, Err(LmeFailure::NotConverged { residual }));
+            }
+            let Some(cholesky) = at.j.cholesky() else {
+                return (at, Err(LmeFailure::Stalled { residual }));
+            };
+            let mut step = -cholesky.solve(&at.r);
+            step *= (self.max_step / step.norm()).min(1.0);
+            match self.line_search(&mu, &step, &at, offsets, weight) {
+                Some((next_mu, next)) => (mu, at) = (next_mu, next),
+                None => {
+                    // The rejected trials overwrote the weights.
+                    let at = Moments::at(self.gamma, &mu, offsets, weight);
+                    return (at, Err(LmeFailure::Stalled { residual }));
+                }
+            }
+            steps += 1;
+        }
+    }
+
+    /// The first of mu + step, mu + step / 2, ... whose log Z passes the Armijo test (up to
+    /// round-off), with its moments and weights; `None` when every halving fails.
+    fn line_search(
+        &self,
+        mu: &SVector<f64, D>,
+        step: &SVector<f64, D>,
+        at: &Moments<D>,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Option<(SVector<f64, D>, Moments<D>)> {
+        let slope = at.r.dot(step);
+        let slack = ROUNDOFF * (1.0 + at.log_z.abs());
+        let mut alpha = 1.0;
+        for _ in 0..=MAX_HALVINGS {
+            let trial_mu = mu + step * alpha;
+            let trial = Moments::at(self.gamma, &trial_mu, offsets, weight);
+            if trial.log_z <= at.log_z + ARMIJO * alpha * slope + slack {
+                return Some((trial_mu, trial));
+            }
+            alpha *= 0.5;
+        }
+        None
+    }
+}
+
+/// log Z, r and J at one multiplier mu, in scaled units.
+struct Moments<const D: usize> {
+    log_z: f64,
+    r: SVector<f64, D>,
+    j: SMatrix<f64, D, D>,
+}
+
+impl<const D: usize> Moments<D> {
+    /// The moments at `mu`, leaving the weights p_a in `weight`.
+    fn at(
+        gamma: f64,
+        mu: &SVector<f64, D>,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Self {
+        // Subtracting the largest exponent keeps exp from overflowing and Z >= 1.
+        let mut largest = f64::NEG_INFINITY;
+        for (p, d) in weight.iter_mut().zip(offsets) {
+            *p = -gamma * d.norm_squared() + mu.dot(d);
+            largest = largest.max(*p);
+        }
+        let mut z = 0.0;
+        for p in weight.iter_mut() {
+            *p = (*p - largest).exp();
+            z += *p;
+        }
+        let mut r = SVector::zeros();
+        for (p, d) in weight.iter_mut().zip(offsets) {
+            *p /= z;
+            r += d * *p;
+        }
+        // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation.
+        let mut j = SMatrix::zeros();
+        for (p, d) in weight.iter().zip(offsets) {
+            let c = d - r;
+            j += c * c.transpose() * *p;
+        }
+        Moments {
+            log_z: largest + z.ln(),
+            r,
+            j,
+        }
+    }
+}
+
+impl<const D: usize> Shape<D> for LocalMaxEnt<D> {
+    fn nodes_per_point(&self) -> usize {
+        self.per_axis.pow(D as u32)
+    }
+
+    fn eval(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> bool {
+        match self.evaluate(grid, x, node, weight, grad) {
+            Ok(_) => true,
+            Err(LmeFailure::Outside) => false,
+            Err(_) => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                true
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

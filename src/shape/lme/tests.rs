@@ -1,0 +1,302 @@
+use nalgebra::{SMatrix, SVector};
+
+use super::*;
+use crate::benchmarks::Domain;
+use crate::rng::Lcg;
+use crate::shape::stencils::assert_gradient_matches_differences;
+use crate::shape::{lattice_coords, LinearHat};
+
+/// The two values of gamma Molinos et al. run.
+const PAPER_GAMMAS: [f64; 2] = [0.8, 3.0];
+
+fn grid<const D: usize>(cells: usize) -> Grid<D> {
+    Grid::new(&Domain {
+        lower: SVector::repeat(-0.5),
+        upper: SVector::repeat(1.5),
+        cells,
+    })
+}
+
+/// One point's stencil, (node, p_a, grad p_a) per entry, and the Newton result.
+type Basis<const D: usize> = (
+    Vec<(usize, f64, SVector<f64, D>)>,
+    Result<usize, LmeFailure>,
+);
+
+fn basis_at<const D: usize>(lme: &LocalMaxEnt<D>, g: &Grid<D>, x: &SVector<f64, D>) -> Basis<D> {
+    let n = lme.nodes_per_point();
+    let (mut node, mut weight, mut grad) = (vec![0; n], vec![0.0; n], vec![SVector::zeros(); n]);
+    let status = lme.evaluate(g, x, &mut node, &mut weight, &mut grad);
+    let entries = (0..n)
+        .map(|e| (node[e] as usize, weight[e], grad[e]))
+        .collect();
+    (entries, status)
+}
+
+/// Along each axis (in cells from the lower face): the faces, points 1e-10 and 1e-3 cells
+/// inside them, the middle of the first cell, the nodes next to the faces and a middle node.
+fn special_coordinates(cells: usize) -> Vec<f64> {
+    let c = cells as f64;
+    let half = (cells / 2) as f64;
+    vec![
+        0.0,
+        1e-10,
+        1e-3,
+        0.5,
+        1.0,
+        half,
+        c - 1.0,
+        c - 1e-3,
+        c - 1e-10,
+        c,
+    ]
+}
+
+/// Random points and every combination of the special coordinates.
+fn points<const D: usize>(g: &Grid<D>, seed: u64) -> Vec<SVector<f64, D>> {
+    let length = g.cells as f64 * g.h;
+    let mut rng = Lcg::new(seed);
+    let mut xs: Vec<SVector<f64, D>> = (0..200)
+        .map(|_| g.lower + SVector::from_fn(|_, _| length * rng.unit()))
+        .collect();
+    let special = special_coordinates(g.cells);
+    let n = [special.len(); D];
+    for m in 0..special.len().pow(D as u32) {
+        let ijk = lattice_coords(m, &n);
+        xs.push(g.lower + SVector::from_fn(|k, _| special[ijk[k]] * g.h));
+    }
+    xs
+}
+
+/// Partition of unity, non-negativity, sum_a p_a x_a = x, sum_a grad p_a = 0 and
+/// sum_a x_a (x) grad p_a = I.
+fn check_consistency<const D: usize>(gamma: f64, cells: usize) {
+    let g = grid::<D>(cells);
+    let lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    for x in points(&g, 0x2545f4914f6cdd1d) {
+        let (entries, status) = basis_at(&lme, &g, &x);
+        status.unwrap_or_else(|e| panic!("{x:?}: {e:?}"));
+        let sum_w: f64 = entries.iter().map(|e| e.1).sum();
+        let sum_wx: SVector<f64, D> = entries
+            .iter()
+            .map(|(i, w, _)| g.node_position(*i) * *w)
+            .sum();
+        let sum_g: SVector<f64, D> = entries.iter().map(|e| e.2).sum();
+        let sum_gx: SMatrix<f64, D, D> = entries
+            .iter()
+            .map(|(i, _, gr)| g.node_position(*i) * gr.transpose())
+            .sum();
+        assert!((sum_w - 1.0).abs() < 1e-14, "{x:?}: sum p = {sum_w}");
+        assert!(entries.iter().all(|e| e.1 >= 0.0), "{x:?}: negative p");
+        let miss = (sum_wx - x).norm() / g.h;
+        assert!(
+            miss < RESIDUAL_TOLERANCE,
+            "{x:?}: |sum p x_a - x| = {miss} h"
+        );
+        assert!(sum_g.norm() * g.h < 1e-12, "{x:?}: sum grad p = {sum_g:?}");
+        let identity = SMatrix::<f64, D, D>::identity();
+        assert!((sum_gx - identity).norm() < 1e-12, "{x:?}: {sum_gx:?}");
+    }
+    assert_eq!(lme.failures(), 0);
+}
+
+#[test]
+fn lme_consistency_1d() {
+    for gamma in PAPER_GAMMAS {
+        for cells in [2, 5, 12] {
+            check_consistency::<1>(gamma, cells);
+        }
+    }
+}
+
+#[test]
+fn lme_consistency_2d() {
+    for gamma in PAPER_GAMMAS {
+        for cells in [2, 5, 10] {
+            check_consistency::<2>(gamma, cells);
+        }
+    }
+}
+
+/// The most Newton steps at the points at least `from_face` cells from every face and at the
+/// others.
+fn most_steps<const D: usize>(gamma: f64, cells: usize, from_face: f64) -> (usize, usize) {
+    let g = grid::<D>(cells);
+    let lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    let (mut inside, mut near_face) = (0, 0);
+    for x in points(&g, 0x2545f4914f6cdd1d) {
+        let steps = basis_at(&lme, &g, &x).1.unwrap();
+        let s = (x - g.lower) / g.h;
+        if s.iter()
+            .all(|&s| s >= from_face && s <= cells as f64 - from_face)
+        {
+            inside = inside.max(steps);
+        } else {
+            near_face = near_face.max(steps);
+        }
+    }
+    (inside, near_face)
+}
+
+/// At gamma = 0.8 and 3 Newton needs at most 10 steps at 1e-4 cells or more from the faces
+/// (1-4 at most random points, 8-10 at 1e-3 cells from a face); 22-24 at 1e-10 cells and
+/// 25-27 on a face, where the multiplier is infinite.
+#[test]
+fn lme_paper_gammas_converge_in_few_iterations() {
+    for gamma in PAPER_GAMMAS {
+        let one = most_steps::<1>(gamma, 12, 1e-4);
+        let two = most_steps::<2>(gamma, 10, 1e-4);
+        for (inside, near_face) in [one, two] {
+            assert!(inside <= 10, "gamma {gamma}: {inside} steps");
+            assert!(near_face <= 30, "gamma {gamma}: {near_face} steps");
+        }
+    }
+}
+
+/// The stencil holds every grid node within the cut-off radius, once, and no other node with
+/// a weight.
+fn check_stencil<const D: usize>(gamma: f64, cells: usize) {
+    let g = grid::<D>(cells);
+    let lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    for x in points(&g, 11) {
+        let (entries, _) = basis_at(&lme, &g, &x);
+        let mut weighted: Vec<usize> = entries.iter().filter(|e| e.1 > 0.0).map(|e| e.0).collect();
+        weighted.sort_unstable();
+        let within: Vec<usize> = (0..g.num_nodes())
+            .filter(|&i| (g.node_position(i) - x).norm() <= lme.radius() * g.h)
+            .collect();
+        assert_eq!(weighted, within, "{x:?}");
+        assert!(entries.iter().all(|e| e.0 < g.num_nodes()));
+    }
+}
+
+#[test]
+fn lme_stencil_holds_the_nodes_within_the_cut_off() {
+    let sizes: Vec<(usize, usize)> = PAPER_GAMMAS
+        .iter()
+        .map(|&gamma| {
+            let one = LocalMaxEnt::<1>::new(gamma).unwrap().nodes_per_point();
+            let two = LocalMaxEnt::<2>::new(gamma).unwrap().nodes_per_point();
+            (one, two)
+        })
+        .collect();
+    assert_eq!(sizes, vec![(9, 81), (5, 25)]);
+    for gamma in PAPER_GAMMAS {
+        check_stencil::<1>(gamma, 3);
+        check_stencil::<1>(gamma, 12);
+        check_stencil::<2>(gamma, 3);
+        check_stencil::<2>(gamma, 10);
+    }
+}
+
+/// Gradients agree with central differences of the values at random points, next to the
+/// faces (1e-3 cells inside, beyond the difference step) and at nodes.
+fn check_gradient<const D: usize>(gamma: f64) {
+    let g = grid::<D>(10);
+    let lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    for x in points(&g, 77) {
+        let s = (x - g.lower) / g.h;
+        if s.iter().all(|&s| s >= 1e-3 && s <= g.cells as f64 - 1e-3) {
+            assert_gradient_matches_differences(&lme, &g, &x, 1e-6);
+        }
+    }
+}
+
+#[test]
+fn lme_gradient_matches_finite_differences_1d() {
+    for gamma in PAPER_GAMMAS {
+        check_gradient::<1>(gamma);
+    }
+}
+
+#[test]
+fn lme_gradient_matches_finite_differences_2d() {
+    for gamma in PAPER_GAMMAS {
+        check_gradient::<2>(gamma);
+    }
+}
+
+/// The largest difference between the weights and the hat's, over random points, points
+/// next to and on the faces, and nodes.
+fn distance_to_hat<const D: usize>(gamma: f64) -> f64 {
+    let g = grid::<D>(6);
+    // A cut-off beyond sqrt(D) h keeps every corner of the point's cell: with fewer, the
+    // large-gamma limit in 2D is linear on triangles, not the bilinear hat.
+    let lme = LocalMaxEnt::<D>::with_tolerance(gamma, (-2.5 * gamma).exp()).unwrap();
+    let hat = <LinearHat as Shape<D>>::nodes_per_point(&LinearHat);
+    let mut worst: f64 = 0.0;
+    for x in points(&g, 5) {
+        let (entries, status) = basis_at(&lme, &g, &x);
+        status.unwrap_or_else(|e| panic!("{x:?}: {e:?}"));
+        let (mut node, mut weight, mut grad) =
+            (vec![0; hat], vec![0.0; hat], vec![SVector::zeros(); hat]);
+        assert!(LinearHat.eval(&g, &x, &mut node, &mut weight, &mut grad));
+        for (i, p, _) in &entries {
+            let n: f64 = (0..hat)
+                .filter(|&c| node[c] as usize == *i)
+                .map(|c| weight[c])
+                .sum();
+            if *p > 0.0 || n > 0.0 {
+                worst = worst.max((p - n).abs());
+            }
+        }
+    }
+    worst
+}
+
+/// As gamma grows the weights tend to the hat's. The largest difference is at a node, where
+/// its 2D neighbours take about e^-gamma each, until the Newton residual dominates.
+#[test]
+fn lme_tends_to_the_linear_hat() {
+    for gamma in [10.0_f64, 30.0, 100.0] {
+        let bound = |d: f64| 2.0 * d * (-gamma).exp() + 2.0 * RESIDUAL_TOLERANCE;
+        let one = distance_to_hat::<1>(gamma);
+        let two = distance_to_hat::<2>(gamma);
+        assert!(one <= bound(1.0), "gamma {gamma}: {one:e}");
+        assert!(two <= bound(2.0), "gamma {gamma}: {two:e}");
+    }
+}
+
+/// An iteration limit of one step fails at most points: `eval` still fills a partition of
+/// unity and counts each failure; a point outside the grid is not a failure.
+#[test]
+fn lme_failures_are_counted() {
+    let g = grid::<2>(6);
+    let lme = LocalMaxEnt::<2>::new(0.8).unwrap().with_max_iterations(1);
+    let xs = points(&g, 3);
+    let n = lme.nodes_per_point();
+    let mut failed = 0;
+    for x in &xs {
+        let (entries, status) = basis_at(&lme, &g, x);
+        if let Err(failure) = status {
+            assert!(matches!(failure, LmeFailure::NotConverged { residual } if residual > 0.0));
+            failed += 1;
+        }
+        let sum_w: f64 = entries.iter().map(|e| e.1).sum();
+        assert!((sum_w - 1.0).abs() < 1e-14 && entries.iter().all(|e| e.1 >= 0.0));
+    }
+    assert!(failed > xs.len() / 2, "{failed} of {}", xs.len());
+    let (mut node, mut weight, mut grad) = (vec![0; n], vec![0.0; n], vec![SVector::zeros(); n]);
+    for x in &xs {
+        assert!(lme.eval(&g, x, &mut node, &mut weight, &mut grad));
+    }
+    assert_eq!(lme.failures(), failed);
+    let outside = SVector::<f64, 2>::new(1.6, 0.0);
+    assert!(!lme.eval(&g, &outside, &mut node, &mut weight, &mut grad));
+    assert_eq!(lme.failures(), failed);
+}
+
+/// gamma and tolerance must give a cut-off radius that surrounds every point of a cell: more
+/// than h in 1D, more than sqrt(5)/2 h in 2D.
+#[test]
+fn lme_parameters_are_validated() {
+    assert!(LocalMaxEnt::<1>::new(0.0).is_err());
+    assert!(LocalMaxEnt::<1>::new(-1.0).is_err());
+    assert!(LocalMaxEnt::<1>::with_tolerance(1.0, 1.0).is_err());
+    assert!(LocalMaxEnt::<1>::with_tolerance(1.0, 0.0).is_err());
+    assert!(LocalMaxEnt::<1>::new(12.0).is_ok());
+    assert!(LocalMaxEnt::<2>::new(12.0).is_err());
+    assert!(LocalMaxEnt::<2>::new(11.0).is_ok());
+    let radius = LocalMaxEnt::<2>::new(0.8).unwrap().radius();
+    assert!((radius - 4.1556).abs() < 1e-4, "{radius}");
+}
