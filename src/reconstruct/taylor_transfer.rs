@@ -433,9 +433,7 @@ impl<const D: usize> TaylorTransfer<D> {
                 .grid
                 .locate(&particles.x[p])
                 .ok_or(Divergence::LeftGrid { particle: p })?;
-            let e = (0..D)
-                .rev()
-                .fold(0, |acc, k| acc * self.grid.cells + cell[k]);
+            let e = self.grid.cell_index(cell);
             self.element_of.push(e as u32);
             self.element_start[e + 1] += 1;
         }

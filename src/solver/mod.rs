@@ -110,7 +110,7 @@ struct Run<'a, const D: usize> {
     /// Nodal velocity rebuilt after the particles moved (MUSL only).
     remapped: Vec<SVector<f64, D>>,
     fits: FitStats,
-    /// The cell of every particle after the last step, to count grid crossings.
+    /// The flat index of every particle's cell, after the last move.
     cells: Vec<usize>,
     grid_crossings: usize,
     recorder: Recorder,
@@ -193,10 +193,12 @@ impl<'a, const D: usize> Run<'a, D> {
         let steps = self.problem.steps();
         let every = self.spec.output_every;
         let mut synced = vec![SVector::zeros(); self.particles.len()];
-        if let Err(reason) = self.update_stencils() {
+        if let Err(reason) = self
+            .locate_particles()
+            .and_then(|()| self.update_stencils())
+        {
             return (0, Err((0, reason)));
         }
-        self.cells = self.particles.x.iter().map(|x| self.cell_of(x)).collect();
         for s in 0..=steps {
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
@@ -244,32 +246,33 @@ impl<'a, const D: usize> Run<'a, D> {
             }
             if let Err(reason) = self
                 .update_particles(kick, dt)
+                .and_then(|()| self.locate_particles())
                 .and_then(|()| self.update_stencils())
             {
                 return (s, Err((s + 1, reason)));
             }
-            self.count_grid_crossings();
         }
         (steps, Ok(()))
     }
 
-    /// Flat index of the cell holding `x`, which the stencils found inside the grid.
-    fn cell_of(&self, x: &SVector<f64, D>) -> usize {
-        self.grid
-            .locate(x)
-            .map_or(usize::MAX, |(cell, _)| self.grid.cell_index(cell))
-    }
-
-    /// Adds the particles that changed cell in the last step (Wobbes et al. sec 5 count them
-    /// to explain MPM's grid-crossing error).
-    fn count_grid_crossings(&mut self) {
-        for p in 0..self.cells.len() {
-            let cell = self.cell_of(&self.particles.x[p]);
+    /// The cell of every particle; after the first call, counts the particles that changed
+    /// cell since the last (Wobbes et al. sec 5 count these grid crossings to explain MPM's
+    /// error).
+    fn locate_particles(&mut self) -> Result<(), Divergence> {
+        let first = self.cells.is_empty();
+        self.cells.resize(self.particles.len(), usize::MAX);
+        for (p, x) in self.particles.x.iter().enumerate() {
+            let (cell, _) = self
+                .grid
+                .locate(x)
+                .ok_or(Divergence::LeftGrid { particle: p })?;
+            let cell = self.grid.cell_index(cell);
             if cell != self.cells[p] {
                 self.cells[p] = cell;
-                self.grid_crossings += 1;
+                self.grid_crossings += usize::from(!first);
             }
         }
+        Ok(())
     }
 
     /// Records how far the totals the last mapping gave the DOFs are from the particles'.
@@ -300,8 +303,9 @@ impl<'a, const D: usize> Run<'a, D> {
                 .update(&QuadraticBSpline, &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
             Basis::DualDomain(dual) => {
-                dual.integrate(&self.grid, &self.particles.x)
-                    .and_then(|()| self.stencils.update(dual, &self.grid, &self.particles.x))
+                dual.integrate(&self.grid, &self.cells);
+                self.stencils
+                    .update(dual, &self.grid, &self.particles.x)
                     .map_err(|particle| Divergence::LeftGrid { particle })?;
                 self.transfer.refresh_basis(dual);
                 Ok(())
