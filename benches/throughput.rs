@@ -1,13 +1,18 @@
-//! Particle-steps per second of each method on the manufactured solutions, one core.
-//! Run with `cargo bench --bench throughput` (or `make bench`).
+//! Particle-steps per second of each method on the manufactured solutions, one core, and the
+//! cost of one LME evaluation (its Newton solve) against the hat's.
+//! Run with `cargo bench --bench throughput` (or `make bench`); a bare word filters by method.
 
 use std::time::Instant;
 
-use mpmlab::benchmarks::{self, thesis_params};
+use nalgebra::SVector;
+
+use mpmlab::benchmarks::{self, thesis_params, Domain};
 use mpmlab::experiment::RunSpec;
-use mpmlab::methods;
+use mpmlab::methods::{self, GAMMA_KEY, INTEGRATOR_KEY};
 use mpmlab::output::RunStatus;
 use mpmlab::params::{ParamValue, Params};
+use mpmlab::rng::Lcg;
+use mpmlab::shape::{Grid, LinearHat, LocalMaxEnt, Shape, Stencils};
 use mpmlab::solver::simulate;
 
 struct Case {
@@ -54,16 +59,125 @@ fn large_strain_bar() -> Params {
     params
 }
 
-fn spec(case: &Case, method: &str) -> RunSpec {
+/// The LME locality values of Molinos et al. (Figs 10-11).
+const GAMMAS: [f64; 2] = [0.8, 3.0];
+
+/// A timed configuration: a preset with the method parameters it is timed with.
+struct Variant {
+    label: String,
+    preset: &'static str,
+    method_params: Params,
+}
+
+/// Every preset as it stands, LME at each of `GAMMAS`, and the original MPM with each
+/// integrator it does not use by default (the particle update is what they change).
+fn variants(filter: Option<&str>) -> Vec<Variant> {
+    let mut variants = Vec::new();
+    for preset in methods::presets() {
+        if filter.is_some_and(|f| f != preset.name) {
+            continue;
+        }
+        let is_lme = matches!(preset.method.shape, methods::ShapeKind::LocalMaxEnt(_));
+        if is_lme {
+            for gamma in GAMMAS {
+                variants.push(Variant {
+                    label: format!("{} g={gamma}", preset.name),
+                    preset: preset.name,
+                    method_params: [(GAMMA_KEY.to_string(), ParamValue::Float(gamma))].into(),
+                });
+            }
+            continue;
+        }
+        variants.push(Variant {
+            label: preset.name.to_string(),
+            preset: preset.name,
+            method_params: Params::new(),
+        });
+        if preset.name == "mpm" {
+            for &integrator in &methods::IntegratorKind::NAMES[1..] {
+                variants.push(Variant {
+                    label: format!("mpm {integrator}"),
+                    preset: preset.name,
+                    method_params: [(
+                        INTEGRATOR_KEY.to_string(),
+                        ParamValue::Str(integrator.into()),
+                    )]
+                    .into(),
+                });
+            }
+        }
+    }
+    variants
+}
+
+fn spec(case: &Case, variant: &Variant) -> RunSpec {
+    let mut params = (case.params)();
+    params.extend(variant.method_params.clone());
     RunSpec {
         experiment: "bench".into(),
         run_id: "bench".into(),
         benchmark: case.benchmark.into(),
-        method: method.into(),
-        params: (case.params)(),
+        method: variant.preset.into(),
+        params,
         axes: Params::new(),
         output_every: 0,
         config_yaml: String::new(),
+    }
+}
+
+/// Microseconds per point of `shape` at `points` random points of a 32-cell grid, best of
+/// three passes.
+fn evaluation_cost<const D: usize>(shape: &dyn Shape<D>, points: usize) -> f64 {
+    let domain = Domain {
+        lower: SVector::zeros(),
+        upper: SVector::repeat(1.0),
+        cells: 32,
+    };
+    let grid = Grid::new(&domain);
+    let mut rng = Lcg::new(7);
+    let x: Vec<SVector<f64, D>> = (0..points)
+        .map(|_| SVector::from_fn(|_, _| rng.unit()))
+        .collect();
+    let mut stencils = Stencils::new(shape.nodes_per_point(), points);
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let started = Instant::now();
+        stencils
+            .update(shape, &grid, &x)
+            .expect("the points are on the grid");
+        best = best.min(started.elapsed().as_secs_f64());
+    }
+    best / points as f64 * 1e6
+}
+
+/// The cost of the LME basis per point (a safeguarded Newton solve over its stencil) beside
+/// the hat's, in 1D and 2D.
+fn lme_evaluation_costs() {
+    println!(
+        "\n{:<16} {:>4} {:>8} {:>12}",
+        "basis", "dim", "nodes", "us/point"
+    );
+    let row = |label: &str, dim: usize, nodes: usize, cost: f64| {
+        println!("{label:<16} {dim:>4} {nodes:>8} {cost:>12.3}");
+    };
+    row("hat", 1, 2, evaluation_cost::<1>(&LinearHat, 200_000));
+    row("hat", 2, 4, evaluation_cost::<2>(&LinearHat, 200_000));
+    for gamma in GAMMAS {
+        let label = format!("lme g={gamma}");
+        let lme1 = LocalMaxEnt::<1>::new(gamma).expect("valid in 1D");
+        row(
+            &label,
+            1,
+            lme1.nodes_per_point(),
+            evaluation_cost(&lme1, 200_000),
+        );
+        let lme2 = LocalMaxEnt::<2>::new(gamma).expect("valid in 2D");
+        row(
+            &label,
+            2,
+            lme2.nodes_per_point(),
+            evaluation_cost(&lme2, 50_000),
+        );
     }
 }
 
@@ -71,15 +185,12 @@ fn main() {
     // Bench harnesses are passed flags such as --bench; a bare word filters by method.
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     println!(
-        "{:<16} {:<14} {:>10} {:>8} {:>10} {:>14}",
+        "{:<24} {:<14} {:>10} {:>8} {:>10} {:>14}",
         "method", "benchmark", "particles", "steps", "seconds", "Mparticle-steps/s"
     );
-    for preset in methods::presets() {
-        if filter.as_deref().is_some_and(|f| f != preset.name) {
-            continue;
-        }
+    for variant in variants(filter.as_deref()) {
         for case in CASES {
-            let spec = spec(case, preset.name);
+            let spec = spec(case, &variant);
             // Best of three: the machine is shared, the minimum is the least disturbed. Runs
             // over ten seconds are timed once.
             let mut best = f64::INFINITY;
@@ -96,8 +207,8 @@ fn main() {
             let record = record.expect("three runs were made");
             if record.status != RunStatus::Ok {
                 println!(
-                    "{:<16} {:<14} {}: {}",
-                    preset.name,
+                    "{:<24} {:<14} {}: {}",
+                    variant.label,
                     case.benchmark,
                     record.status.as_str(),
                     record.message
@@ -107,9 +218,12 @@ fn main() {
             let particles = record.particles.len();
             let rate = (particles * record.steps) as f64 / best / 1e6;
             println!(
-                "{:<16} {:<14} {:>10} {:>8} {:>10.3} {:>14.1}",
-                preset.name, case.benchmark, particles, record.steps, best, rate
+                "{:<24} {:<14} {:>10} {:>8} {:>10.3} {:>14.1}",
+                variant.label, case.benchmark, particles, record.steps, best, rate
             );
         }
+    }
+    if filter.as_deref().is_none_or(|f| f == "lme") {
+        lme_evaluation_costs();
     }
 }

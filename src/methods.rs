@@ -3,13 +3,15 @@
 
 use std::fmt;
 
+use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
+use crate::params::{get_f64, get_str, ParamError, Params};
 use crate::reconstruct::{
     Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe, Weight,
 };
-use crate::shape::DomainShape;
+use crate::shape::{DomainShape, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
 
 /// Basis functions used on the background grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShapeKind {
     /// Piecewise-linear hat (tensor product in 2D), Gong eq 4.8.
     Linear,
@@ -21,6 +23,17 @@ pub enum ShapeKind {
     /// The hat's values with the dual-domain gradient, the hat's gradient averaged over the
     /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011).
     DualDomain,
+    /// Local maximum-entropy functions on the grid nodes (Arroyo & Ortiz 2006; Molinos et al.
+    /// sec 5), with the locality gamma and the neighbour cut-off of the run.
+    LocalMaxEnt(LmeSettings),
+}
+
+/// The parameters of the LME basis: gamma = beta h^2 and the prior weight exp(-beta r^2) below
+/// which a node is left out of a point's stencil.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LmeSettings {
+    pub gamma: f64,
+    pub tolerance: f64,
 }
 
 /// How particle data reaches the grid.
@@ -47,6 +60,62 @@ pub enum IntegratorKind {
     /// Whole-step velocities, particles moved first, velocity gradient from the nodal
     /// velocity rebuilt from the moved particles (Tran eqs 31-40; Sulsky's MUSL).
     Musl,
+    /// Sulsky et al. 1994 as Molinos et al. eqs 21-22 write it: whole-step velocities,
+    /// v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the start-of-step nodal
+    /// velocity, the stress from the updated nodal velocity v_i + dt a_i.
+    Euler,
+    /// Eqs 23-24 (Zhang et al. 2016): the particle update of eqs 21-22 written with nodal
+    /// momenta, and the stress from the nodal velocity rebuilt from the updated particle
+    /// velocities, which stays bounded where a nodal mass vanishes.
+    EulerCorrected,
+    /// The explicit Newmark predictor-corrector (gamma = 1/2, beta = 0) of Molinos et al.
+    /// sec 4: a nodal velocity carried by the grid, predicted with half the old acceleration,
+    /// corrected with half the new one; the particles move with the predictor (eq 28).
+    PredictorCorrector,
+}
+
+impl IntegratorKind {
+    /// The names the `integrator` parameter takes, in the order of `ALL`.
+    pub const NAMES: &'static [&'static str] = &[
+        "leapfrog",
+        "musl",
+        "euler",
+        "euler_corrected",
+        "predictor_corrector",
+    ];
+    const ALL: [IntegratorKind; 5] = [
+        IntegratorKind::Leapfrog,
+        IntegratorKind::Musl,
+        IntegratorKind::Euler,
+        IntegratorKind::EulerCorrected,
+        IntegratorKind::PredictorCorrector,
+    ];
+
+    pub fn name(self) -> &'static str {
+        let index = Self::ALL.iter().position(|&k| k == self);
+        Self::NAMES[index.expect("every integrator is listed in ALL")]
+    }
+
+    fn from_name(name: &str) -> Option<Self> {
+        let index = Self::NAMES.iter().position(|&n| n == name)?;
+        Some(Self::ALL[index])
+    }
+
+    /// Whether the particles carry v^{s-1/2} between steps and start with a half kick: the
+    /// leapfrog, and the predictor-corrector, whose particle velocities take half of the
+    /// acceleration in its corrector and half in the next predictor.
+    pub fn staggers_velocity(self) -> bool {
+        matches!(
+            self,
+            IntegratorKind::Leapfrog | IntegratorKind::PredictorCorrector
+        )
+    }
+
+    /// Whether the particles move with the start-of-step nodal velocity (eqs 21-24) rather
+    /// than the updated one.
+    pub fn drifts_with_start_velocity(self) -> bool {
+        matches!(self, IntegratorKind::Euler | IntegratorKind::EulerCorrected)
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -252,6 +321,19 @@ const PRESETS: &[MethodPreset] = &[
         description: "CPDI2 with IMPM's MLS velocity at the nodes (cubic spline), leapfrog",
     },
     MethodPreset {
+        name: "lme",
+        method: Method {
+            shape: ShapeKind::LocalMaxEnt(LmeSettings {
+                gamma: f64::NAN,
+                tolerance: DEFAULT_TOLERANCE,
+            }),
+            transfer: TransferKind::Shepard,
+            integrator: IntegratorKind::PredictorCorrector,
+        },
+        source: "Molinos, Navas, Pastor, Stickle, secs 4-5",
+        description: "local max-ent basis (gamma from the run), lumped mass, predictor-corrector",
+    },
+    MethodPreset {
         name: "bsmpm",
         method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Shepard),
         source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
@@ -296,6 +378,125 @@ pub fn preset_names() -> Vec<&'static str> {
     PRESETS.iter().map(|p| p.name).collect()
 }
 
+pub const GAMMA_KEY: &str = "gamma";
+pub const LME_TOLERANCE_KEY: &str = "lme_tolerance";
+pub const INTEGRATOR_KEY: &str = "integrator";
+
+/// Parameters of the method rather than the benchmark, settable in `params` or as matrix axes
+/// of any simulation. They have no defaults that enter a run: a run that does not set them has
+/// none in its configuration, so run ids of methods that do not use them do not change.
+pub const METHOD_PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        key: GAMMA_KEY,
+        kind: ParamKind::PositiveReal,
+        default: ParamDefault::Required,
+        unit: "1",
+        doc: "LME locality gamma = beta h^2 (LME methods only, which need it)",
+    },
+    ParamSpec {
+        key: LME_TOLERANCE_KEY,
+        kind: ParamKind::PositiveReal,
+        default: ParamDefault::Float(DEFAULT_TOLERANCE),
+        unit: "1",
+        doc: "LME neighbour cut-off: nodes with exp(-beta r^2) below it are left out (LME only)",
+    },
+    ParamSpec {
+        key: INTEGRATOR_KEY,
+        kind: ParamKind::Choice(IntegratorKind::NAMES),
+        default: ParamDefault::Text("the preset's"),
+        unit: "",
+        doc: "time integrator in place of the preset's (Shepard-transfer methods only)",
+    },
+];
+
+/// The method a run uses: the preset, its integrator replaced by the run's `integrator`, its
+/// LME basis given the run's gamma and cut-off. Checks that the run's method parameters apply
+/// to the preset and are valid in `dim` dimensions.
+pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Method, ParamError> {
+    let mut method = preset.method;
+    if let ShapeKind::LocalMaxEnt(lme) = &mut method.shape {
+        if !params.contains_key(GAMMA_KEY) {
+            return Err(ParamError::new(
+                GAMMA_KEY,
+                format!(
+                    "method {} needs {GAMMA_KEY} (the LME locality beta h^2), e.g. \
+                     {GAMMA_KEY}: [0.8, 3.0]",
+                    preset.name
+                ),
+            ));
+        }
+        lme.gamma = get_f64(params, GAMMA_KEY)?;
+        if params.contains_key(LME_TOLERANCE_KEY) {
+            lme.tolerance = get_f64(params, LME_TOLERANCE_KEY)?;
+        }
+        check_lme(lme, dim)?;
+    } else {
+        for key in [GAMMA_KEY, LME_TOLERANCE_KEY] {
+            if params.contains_key(key) {
+                return Err(ParamError::new(
+                    key,
+                    format!(
+                        "{key} applies to LME methods only ({}), not to {}; put the LME runs \
+                         in a matrix block of their own",
+                        lme_preset_names().join(", "),
+                        preset.name
+                    ),
+                ));
+            }
+        }
+    }
+    if params.contains_key(INTEGRATOR_KEY) {
+        let name = get_str(params, INTEGRATOR_KEY)?;
+        let integrator = IntegratorKind::from_name(name).ok_or_else(|| {
+            ParamError::new(
+                INTEGRATOR_KEY,
+                format!(
+                    "unknown integrator '{name}'; valid: {}",
+                    IntegratorKind::NAMES.join(", ")
+                ),
+            )
+        })?;
+        if integrator != preset.method.integrator && method.transfer != TransferKind::Shepard {
+            return Err(ParamError::new(
+                INTEGRATOR_KEY,
+                format!(
+                    "{} maps with {}, whose grid solve belongs to its own integrator; the \
+                     integrator can be replaced for the methods with the Shepard transfer: {}",
+                    preset.name,
+                    method.transfer,
+                    shepard_preset_names().join(", ")
+                ),
+            ));
+        }
+        method.integrator = integrator;
+    }
+    Ok(method)
+}
+
+fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {
+    let valid: Result<(), LmeParamError> = match dim {
+        1 => LocalMaxEnt::<1>::with_tolerance(lme.gamma, lme.tolerance).map(drop),
+        _ => LocalMaxEnt::<2>::with_tolerance(lme.gamma, lme.tolerance).map(drop),
+    };
+    valid.map_err(|e| ParamError::new(GAMMA_KEY, e.to_string()))
+}
+
+fn lme_preset_names() -> Vec<&'static str> {
+    PRESETS
+        .iter()
+        .filter(|p| matches!(p.method.shape, ShapeKind::LocalMaxEnt(_)))
+        .map(|p| p.name)
+        .collect()
+}
+
+fn shepard_preset_names() -> Vec<&'static str> {
+    PRESETS
+        .iter()
+        .filter(|p| p.method.transfer == TransferKind::Shepard)
+        .map(|p| p.name)
+        .collect()
+}
+
 impl fmt::Display for ShapeKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -303,6 +504,9 @@ impl fmt::Display for ShapeKind {
             ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
             ShapeKind::QuadraticBSpline => f.write_str("quadratic-bspline"),
             ShapeKind::DualDomain => f.write_str("dual-domain"),
+            ShapeKind::LocalMaxEnt(lme) => {
+                write!(f, "lme(gamma={}, tolerance={})", lme.gamma, lme.tolerance)
+            }
         }
     }
 }
@@ -320,10 +524,7 @@ impl fmt::Display for TransferKind {
 
 impl fmt::Display for IntegratorKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            IntegratorKind::Leapfrog => "leapfrog",
-            IntegratorKind::Musl => "musl",
-        })
+        f.write_str(self.name())
     }
 }
 

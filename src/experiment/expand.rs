@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use crate::benchmarks;
+use crate::methods;
 use crate::params::{ParamError, Params};
 use crate::reference;
 
@@ -154,6 +155,8 @@ fn resolve(
         return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
     }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
+    check_method_params(&method, benchmark, &params)
+        .map_err(|e| check_error(e, benchmark, &params, chosen))?;
     let body = config_body(benchmark.info.name, &method, output_every, &params);
     Ok(RunSpec {
         experiment: experiment.to_string(),
@@ -165,6 +168,31 @@ fn resolve(
         output_every,
         config_yaml: config_yaml(experiment, &body),
     })
+}
+
+/// The method parameters of a simulation run (`gamma`, `integrator`, ...) must suit its method:
+/// `methods::resolve` says whether they do. Reference solvers take none.
+fn check_method_params(
+    method: &str,
+    benchmark: &Benchmark,
+    params: &Params,
+) -> Result<(), ParamError> {
+    if let Some(preset) = methods::preset(method) {
+        return methods::resolve(preset, params, benchmark.info.dim).map(drop);
+    }
+    match methods::METHOD_PARAMS
+        .iter()
+        .find(|spec| params.contains_key(spec.key))
+    {
+        Some(spec) if reference::method(method).is_some() => Err(ParamError::new(
+            spec.key,
+            format!(
+                "{} applies to MPM methods, not to the reference solver {method}",
+                spec.key
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Places a failed benchmark check at the value it names: the matrix element or params entry

@@ -39,7 +39,7 @@ pub(crate) fn read(
         let field = child_field(FIELD, e.key);
         let axis = space
             .axes()
-            .iter()
+            .into_iter()
             .find(|a| a.key == e.key)
             .ok_or_else(|| {
                 ConfigError::at(

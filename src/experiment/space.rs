@@ -9,6 +9,7 @@
 use std::collections::HashMap;
 
 use crate::benchmarks::{self, BenchmarkInfo, ParamDefault};
+use crate::methods;
 use crate::params::ParamValue;
 
 use super::document::Sections;
@@ -74,8 +75,16 @@ impl ParamSpace {
     }
 
     /// The axes (keys and kinds; their values are the first block's).
-    pub fn axes(&self) -> &[Axis] {
-        &self.blocks[0].axes
+    /// Every axis of the matrix: the first block's, then the method parameters that only
+    /// later blocks list, in order of first appearance.
+    pub fn axes(&self) -> Vec<&Axis> {
+        let mut axes: Vec<&Axis> = Vec::new();
+        for axis in self.blocks.iter().flat_map(|b| &b.axes) {
+            if !axes.iter().any(|a| a.key == axis.key) {
+                axes.push(axis);
+            }
+        }
+        axes
     }
 
     /// Every value axis `key` takes in any block, in order of first appearance.
@@ -122,7 +131,7 @@ impl ParamSpace {
 
     /// The axes that split runs into convergence groups: all but `cells`.
     pub fn group_axes(&self) -> impl Iterator<Item = &Axis> {
-        self.axes().iter().filter(|a| a.key != CELLS_KEY)
+        self.axes().into_iter().filter(|a| a.key != CELLS_KEY)
     }
 
     /// The group axis named `key`. Otherwise an error at `pos` saying `unknown` (or why
@@ -195,11 +204,18 @@ fn read_matrix(
     Ok(blocks)
 }
 
-/// Puts `block`'s axes in the order of `first`'s, which must have the same keys: every run
-/// then has a value for every axis.
+/// Puts `block`'s axes in the order of `first`'s (axes `first` lacks last), which must have
+/// the same keys apart from method parameters: every run then has a value for every axis but
+/// those that apply to some methods only (`gamma` for LME), which a block of other methods
+/// leaves out.
 fn align(block: &mut Block, first: &Block, field: &str) -> Result<(), ConfigError> {
     let keys = |b: &Block| {
-        let mut keys: Vec<String> = b.axes.iter().map(|a| a.key.clone()).collect();
+        let mut keys: Vec<String> = b
+            .axes
+            .iter()
+            .map(|a| a.key.clone())
+            .filter(|key| !methods::METHOD_PARAMS.iter().any(|p| p.key == key))
+            .collect();
         keys.sort();
         keys
     };
@@ -208,17 +224,26 @@ fn align(block: &mut Block, first: &Block, field: &str) -> Result<(), ConfigErro
             block.pos,
             field,
             format!(
-                "every block of the matrix lists the same axes; this one has [{}], the first \
-                 has [{}]",
+                "every block of the matrix lists the same axes, apart from the method \
+                 parameters ({}); this one has [{}], the first has [{}]",
+                method_param_keys().join(", "),
                 keys(block).join(", "),
                 keys(first).join(", ")
             ),
         ));
     }
-    block
-        .axes
-        .sort_by_key(|a| first.axes.iter().position(|f| f.key == a.key));
+    block.axes.sort_by_key(|a| {
+        first
+            .axes
+            .iter()
+            .position(|f| f.key == a.key)
+            .unwrap_or(usize::MAX)
+    });
     Ok(())
+}
+
+fn method_param_keys() -> Vec<&'static str> {
+    methods::METHOD_PARAMS.iter().map(|p| p.key).collect()
 }
 
 fn read_block(

@@ -46,10 +46,16 @@ pub(crate) fn settable_kind(
     if entry.key == METHOD_KEY {
         return Ok(ValueKind::Method(benchmarks::kind(info)));
     }
-    match info.params.iter().find(|p| p.key == entry.key) {
+    let method_params = if benchmarks::kind(info).is_reconstruction() {
+        &[]
+    } else {
+        methods::METHOD_PARAMS
+    };
+    let mut settable = info.params.iter().chain(method_params);
+    match settable.clone().find(|p| p.key == entry.key) {
         Some(p) => Ok(ValueKind::Param(p.kind)),
         None => {
-            let valid = info.params.iter().map(|p| p.key).chain([METHOD_KEY]);
+            let valid = settable.by_ref().map(|p| p.key).chain([METHOD_KEY]);
             Err(ConfigError::at(
                 entry.key_pos,
                 child_field(parent, entry.key),

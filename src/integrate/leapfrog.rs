@@ -1,6 +1,8 @@
 //! Leapfrog with half-step velocities and the particle update of Gong sec 4.4 (and of IMPM,
 //! sec 5.4). Between steps the particles carry v^{s-1/2}; the first step is a half kick
-//! (v^{1/2} = v^0 + a^0 dt/2, as Gong suggests after eq 4.24).
+//! (v^{1/2} = v^0 + a^0 dt/2, as Gong suggests after eq 4.24). The same update serves the
+//! predictor-corrector (with the grid's carried velocity) and forward Euler (whole kicks,
+//! moved with the start-of-step velocity).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -16,10 +18,15 @@ use crate::shape::Stencils;
 /// F_p = (I + dt sum_i v_i^{s+1/2} (x) grad N_ip) F_p, then J and the stress.
 /// Eq 4.28 prints grad N_i(x_p^{s+1}); Gong's implementation notes (sec 5.4) use the element
 /// found at the start of the step, i.e. x_p^s, which is what is done here (docs/NOTES.md).
+///
+/// The particles move with the nodal velocity `drift`: the updated one `grid.velocity_new`
+/// (leapfrog, predictor-corrector) or the start-of-step one `grid.velocity` (forward Euler,
+/// Molinos et al. eq 22); F always follows `grid.velocity_new`.
 pub fn update_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
     grid: &GridState<D>,
+    drift: &[SVector<f64, D>],
     kick: f64,
     dt: f64,
     material: &Material,
@@ -29,10 +36,9 @@ pub fn update_particles<const D: usize>(
         let mut v = SVector::<f64, D>::zeros();
         let mut grad_v = SMatrix::<f64, D, D>::zeros();
         for (i, w, g) in stencils.of(p) {
-            let vi = grid.velocity_new[i];
             a += grid.force[i] * w;
-            v += vi * w;
-            grad_v += vi * g.transpose();
+            v += drift[i] * w;
+            grad_v += grid.velocity_new[i] * g.transpose();
         }
         particles.v[p] += a * kick;
         particles.x[p] += v * dt;

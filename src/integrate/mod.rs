@@ -3,6 +3,7 @@
 mod deform;
 pub mod leapfrog;
 pub mod musl;
+pub mod predictor_corrector;
 
 use std::fmt;
 

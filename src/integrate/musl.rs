@@ -13,11 +13,14 @@ use crate::particles::Particles;
 use crate::reconstruct::GridState;
 use crate::shape::Stencils;
 
-/// Eqs 34-35: v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i^{t+1}.
+/// Eqs 34-35: v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the nodal velocity
+/// `drift`: v_i^{t+1} (`grid.velocity_new`, MUSL), or the start-of-step v_i^t
+/// (`grid.velocity`, Molinos et al. eq 23).
 pub fn move_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
     grid: &GridState<D>,
+    drift: &[SVector<f64, D>],
     dt: f64,
 ) -> Result<(), Divergence> {
     for p in 0..particles.len() {
@@ -25,7 +28,7 @@ pub fn move_particles<const D: usize>(
         let mut v = SVector::<f64, D>::zeros();
         for (i, w, _) in stencils.of(p) {
             a += grid.force[i] * w;
-            v += grid.velocity_new[i] * w;
+            v += drift[i] * w;
         }
         if !a.iter().chain(v.iter()).all(|c| c.is_finite()) {
             return Err(Divergence::NonFinite {

@@ -132,4 +132,7 @@ pub struct Diagnostics {
     pub rank_deficient: usize,
     /// Particle moves from one grid cell to another, summed over the steps.
     pub grid_crossings: usize,
+    /// LME evaluations whose Newton iteration stopped short (`shape::LmeFailure`): each still
+    /// fills its stencil from the last iterate, which is why the count is kept.
+    pub lme_failures: usize,
 }

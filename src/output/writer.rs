@@ -81,6 +81,7 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
         ("reconstructions", r.diagnostics.reconstructions),
         ("rank_deficient", r.diagnostics.rank_deficient),
         ("grid_crossings", r.diagnostics.grid_crossings),
+        ("lme_failures", r.diagnostics.lme_failures),
     ] {
         attr_i64(&diagnostics, name, value as i64)?;
     }

@@ -12,13 +12,15 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, Problem};
 use crate::experiment::RunSpec;
+use crate::integrate::predictor_corrector::CarriedVelocity;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
 use crate::reconstruct::{FitStats, GridState};
 use crate::shape::{
-    Dofs, DualDomain, Grid, LinearHat, ParticleDomains, QuadraticBSpline, Shape, Stencils,
+    Dofs, DualDomain, Grid, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape,
+    Stencils,
 };
 
 use recorder::Recorder;
@@ -59,7 +61,12 @@ fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
         )
     })?;
     let problem = benchmarks::build(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
-    Ok((preset.method, problem))
+    let dim = match problem {
+        AnyProblem::D1(_) => 1,
+        AnyProblem::D2(_) => 2,
+    };
+    let method = methods::resolve(preset, &spec.params, dim).map_err(|e| e.to_string())?;
+    Ok((method, problem))
 }
 
 /// The grid basis of a run as the particles see it.
@@ -72,6 +79,8 @@ enum Basis<const D: usize> {
     BSpline,
     /// The hat with the dual-domain gradient, from the integrals over this step's material.
     DualDomain(DualDomain<D>),
+    /// Local maximum-entropy functions evaluated at x_p.
+    LocalMaxEnt(LocalMaxEnt<D>),
 }
 
 /// The particle-to-grid mappings of a step: the transfer at its start, and MUSL's remap of
@@ -90,6 +99,7 @@ impl<const D: usize> Basis<D> {
             Basis::Hat | Basis::Domains(_) => &LinearHat,
             Basis::BSpline => &QuadraticBSpline,
             Basis::DualDomain(dual) => dual,
+            Basis::LocalMaxEnt(lme) => lme,
         }
     }
 }
@@ -107,8 +117,10 @@ struct Run<'a, const D: usize> {
     nodes: GridState<D>,
     fixed: Vec<FixedDof>,
     body_force: Vec<SVector<f64, D>>,
-    /// Nodal velocity rebuilt after the particles moved (MUSL only).
+    /// Nodal velocity rebuilt after the particles moved (MUSL and eqs 23-24 only).
     remapped: Vec<SVector<f64, D>>,
+    /// The nodal velocity the grid carries between steps (predictor-corrector only).
+    carried: Option<CarriedVelocity<D>>,
     fits: FitStats,
     /// The flat index of every particle's cell, after the last move.
     cells: Vec<usize>,
@@ -120,7 +132,10 @@ impl<'a, const D: usize> Run<'a, D> {
     fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>) -> Self {
         let dofs = match method.shape {
             ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
-            ShapeKind::Linear | ShapeKind::Domain(_) | ShapeKind::DualDomain => Dofs::Nodes,
+            ShapeKind::Linear
+            | ShapeKind::Domain(_)
+            | ShapeKind::DualDomain
+            | ShapeKind::LocalMaxEnt(_) => Dofs::Nodes,
         };
         let grid = Grid::with_dofs(&problem.domain(), dofs);
         let particles = Particles::seed(problem.as_ref(), &grid);
@@ -143,7 +158,16 @@ impl<'a, const D: usize> Run<'a, D> {
                 let per_point = dual.nodes_per_point();
                 (Basis::DualDomain(dual), per_point)
             }
+            ShapeKind::LocalMaxEnt(settings) => {
+                // `methods::resolve` has checked gamma and the cut-off for this dimension.
+                let lme = LocalMaxEnt::with_tolerance(settings.gamma, settings.tolerance)
+                    .expect("LME parameters are validated before a run starts");
+                let per_point = lme.nodes_per_point();
+                (Basis::LocalMaxEnt(lme), per_point)
+            }
         };
+        let carried = (method.integrator == IntegratorKind::PredictorCorrector)
+            .then(|| CarriedVelocity::new(grid.num_nodes()));
         Run {
             spec,
             method,
@@ -152,6 +176,7 @@ impl<'a, const D: usize> Run<'a, D> {
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
+            carried,
             grid,
             particles,
             fixed,
@@ -181,6 +206,10 @@ impl<'a, const D: usize> Run<'a, D> {
                     reconstructions: self.fits.fits,
                     rank_deficient: self.fits.rank_deficient,
                     grid_crossings: self.grid_crossings,
+                    lme_failures: match &self.basis {
+                        Basis::LocalMaxEnt(lme) => lme.failures(),
+                        _ => 0,
+                    },
                 },
             },
         )
@@ -212,12 +241,18 @@ impl<'a, const D: usize> Run<'a, D> {
                 Err(reason) => return (s, Err((s, reason))),
             }
             self.track_mapping(Mapping::Step);
-            // Leapfrog starts with a half kick from v^0 to v^{1/2}.
-            let leapfrog = self.method.integrator == IntegratorKind::Leapfrog;
-            let kick = if leapfrog && s == 0 { 0.5 * dt } else { dt };
+            // Staggered velocities start with a half kick from v^0 to v^{1/2}.
+            let staggered = self.method.integrator.staggers_velocity();
+            let kick = if staggered && s == 0 { 0.5 * dt } else { dt };
+            if let Some(carried) = &self.carried {
+                carried.substitute(&mut self.nodes);
+            }
             self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick);
+            if let Some(carried) = &mut self.carried {
+                carried.keep(&self.nodes);
+            }
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
-                let velocity = if leapfrog {
+                let velocity = if staggered {
                     let half = if s == 0 { 0.0 } else { 0.5 * dt };
                     leapfrog::synchronized_velocity(
                         &self.stencils,
@@ -310,26 +345,39 @@ impl<'a, const D: usize> Run<'a, D> {
                 self.transfer.refresh_basis(dual);
                 Ok(())
             }
+            Basis::LocalMaxEnt(lme) => self
+                .stencils
+                .update(lme, &self.grid, &self.particles.x)
+                .map_err(|particle| Divergence::LeftGrid { particle }),
         }
     }
 
     /// Step 3 of the method's integrator, after the grid solve.
     fn update_particles(&mut self, kick: f64, dt: f64) -> Result<(), Divergence> {
         let material = self.problem.material();
+        let integrator = self.method.integrator;
+        let drift = if integrator.drifts_with_start_velocity() {
+            &self.nodes.velocity
+        } else {
+            &self.nodes.velocity_new
+        };
         if let Basis::Domains(domains) = &mut self.basis {
-            domains.advance_corners(&self.grid, &self.nodes.velocity_new, dt)?;
+            domains.advance_corners(&self.grid, drift, dt)?;
         }
-        match self.method.integrator {
-            IntegratorKind::Leapfrog => leapfrog::update_particles(
+        match integrator {
+            IntegratorKind::Leapfrog
+            | IntegratorKind::PredictorCorrector
+            | IntegratorKind::Euler => leapfrog::update_particles(
                 &self.stencils,
                 &mut self.particles,
                 &self.nodes,
+                drift,
                 kick,
                 dt,
                 &material,
             ),
-            IntegratorKind::Musl => {
-                musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, dt)?;
+            IntegratorKind::Musl | IntegratorKind::EulerCorrected => {
+                musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, drift, dt)?;
                 self.transfer.remap_velocity(
                     &self.stencils,
                     &self.particles,
