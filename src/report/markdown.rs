@@ -76,7 +76,7 @@ fn overview(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
 fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
     md.push_str("## Runs\n\n");
     // Reconstruction runs take no time steps.
-    let stepped = !experiment.kind.is_reconstruction();
+    let stepped = experiment.kind.steps();
     let mut header = vec!["run".to_string()];
     header.extend(experiment.axes.iter().cloned());
     header.extend(["h", "status"].map(String::from));
