@@ -149,7 +149,7 @@ mod tests {
         assert!(check(&with(&[])).is_ok());
         // -ln(1e-6) = 13.8 bounds gamma in 1D, 0.8 times it in 2D.
         let gamma = ("gamma", ParamValue::Float(12.0));
-        assert!(check(&with(&[gamma.clone()])).is_ok());
+        assert!(check(&with(std::slice::from_ref(&gamma))).is_ok());
         let e = check(&with(&[gamma, ("dim", ParamValue::Int(2))])).unwrap_err();
         assert_eq!(e.key, "gamma");
         assert!(e.message.contains("in 2D"), "{e}");
