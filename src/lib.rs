@@ -23,4 +23,5 @@ pub mod report;
 pub mod rng;
 pub mod runner;
 pub mod shape;
+pub mod shape_methods;
 pub mod solver;

@@ -5,7 +5,9 @@ use clap::{Parser, Subcommand};
 
 use mpmlab::collect::collect;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions};
-use mpmlab::{benchmarks, experiment, methods, reconstruction_methods, reference, report};
+use mpmlab::{
+    benchmarks, experiment, methods, reconstruction_methods, reference, report, shape_methods,
+};
 
 /// mpmlab: run Material Point Method experiment matrices and report their convergence.
 #[derive(Parser)]
@@ -176,13 +178,22 @@ fn list_methods() {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
         println!("{:<15} degree={} fit={}", "", m.degree.value(), m.fit);
     }
+    println!("\nGrid bases (shape_functions; gamma and tolerance are parameters of lme):");
+    for m in shape_methods::methods() {
+        println!("{:<15} {}  [{}]", m.name, m.description, m.source);
+    }
 }
 
 fn list_benchmarks() {
     for b in benchmarks::catalog() {
         let kind = benchmarks::kind(b);
-        // The element-wise benchmark runs in its function's dimension.
-        let dims = if kind == benchmarks::BenchmarkKind::Elementwise {
+        // The element-wise benchmark runs in its function's dimension, shape_functions in its
+        // `dim`.
+        let varies = [
+            benchmarks::BenchmarkKind::Elementwise,
+            benchmarks::BenchmarkKind::ShapeFunctions,
+        ];
+        let dims = if varies.contains(&kind) {
             format!("1D or {}D", b.dim)
         } else {
             format!("{}D", b.dim)

@@ -416,8 +416,9 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
     let mut method = preset.method;
     if let ShapeKind::LocalMaxEnt(lme) = &mut method.shape {
         if !params.contains_key(GAMMA_KEY) {
+            // Placed at the method, which is what was written.
             return Err(ParamError::new(
-                GAMMA_KEY,
+                "method",
                 format!(
                     "method {} needs {GAMMA_KEY} (the LME locality beta h^2), e.g. \
                      {GAMMA_KEY}: [0.8, 3.0]",

@@ -966,7 +966,7 @@ fn figures_and_tables_must_suit_the_benchmark() {
         10,
         28,
         "figures[0].by",
-        "applies to convergence figures only",
+        "applies to convergence and shape_functions figures only",
         &[],
     );
     let e = error(&edited_in(
@@ -1157,4 +1157,105 @@ fn element_wise_experiments_are_checked() {
     ));
     assert_eq!(e.field, "tables[0].kind", "{e}");
     assert!(e.valid.contains(&"element_fits".to_string()), "{e}");
+}
+
+/// The original MPM beside LME on Gong's problem: blocks that differ in a method parameter.
+const LME: &str = "\
+name: lme
+benchmark: mms1d_gong
+params: {E: 1.0e7, nu: 0.3, rho0: 1000.0, t_end: 0.02, cfl: 0.4, ppc: 2, G: 1.0e-4}
+matrix:
+  - {method: [mpm], integrator: [leapfrog, predictor_corrector], cells: [8, 16]}
+  - {method: [lme], gamma: [0.8, 3.0], integrator: [predictor_corrector], cells: [8, 16]}
+";
+
+#[test]
+fn method_parameters_are_axes_that_blocks_may_leave_out() {
+    let exp = parse(LME).unwrap();
+    assert_eq!(exp.runs.len(), 8);
+    assert_eq!(exp.axes, ["method", "integrator", "cells", "gamma"]);
+    let mpm = exp.runs.iter().find(|r| r.method == "mpm").unwrap();
+    assert!(!mpm.params.contains_key("gamma"), "{:?}", mpm.params);
+    // Other axes must still agree between blocks.
+    let e = error(&LME.replace(
+        "integrator: [predictor_corrector], cells",
+        "courant_limit: [1.0], cells",
+    ));
+    check(
+        &e,
+        6,
+        5,
+        "matrix[1]",
+        "apart from the method parameters",
+        &[],
+    );
+}
+
+#[test]
+fn lme_needs_a_valid_gamma_and_other_methods_refuse_it() {
+    let e = error(&LME.replace("gamma: [0.8, 3.0], ", ""));
+    check(
+        &e,
+        6,
+        15,
+        "matrix[1].method[0]",
+        "method lme needs gamma",
+        &[],
+    );
+    let e = error(&LME.replace(
+        "{method: [mpm], integrator",
+        "{method: [mpm], gamma: [1.0], integrator",
+    ));
+    check(
+        &e,
+        5,
+        29,
+        "matrix[0].gamma[0]",
+        "gamma applies to LME methods only (lme)",
+        &[],
+    );
+    let e = error(&LME.replace("gamma: [0.8, 3.0]", "gamma: [0.8, 30.0]"));
+    check(&e, 6, 34, "matrix[1].gamma[1]", "cut-off radius", &[]);
+    assert!(e.message.contains("method=lme"), "{e}");
+    let e = error(&LME.replace("gamma: [0.8, 3.0]", "gamma: [0.8, -3.0]"));
+    check(
+        &e,
+        6,
+        34,
+        "matrix[1].gamma[1]",
+        "expected a finite number > 0",
+        &[],
+    );
+}
+
+#[test]
+fn integrator_must_be_known_and_fit_the_transfer() {
+    let e = error(&LME.replace("integrator: [leapfrog,", "integrator: [rk4,"));
+    check(
+        &e,
+        5,
+        34,
+        "matrix[0].integrator[0]",
+        "rk4",
+        &[
+            "leapfrog",
+            "musl",
+            "euler",
+            "euler_corrected",
+            "predictor_corrector",
+        ],
+    );
+    let e = error(&LME.replace("{method: [mpm],", "{method: [mpm_tls],"));
+    check(
+        &e,
+        5,
+        38,
+        "matrix[0].integrator[0]",
+        "maps with taylor",
+        &[],
+    );
+    assert!(
+        e.message.contains("Shepard transfer: mpm, mpm_musl,"),
+        "{e}"
+    );
 }

@@ -60,6 +60,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         final_norms,
         reconstruction: None,
         elements: None,
+        shape_functions: None,
         velocity_history: None,
         profile: None,
     }

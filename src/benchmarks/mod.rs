@@ -1,10 +1,12 @@
 //! Benchmark problems: domain, material, initial and boundary conditions, body force and the
 //! exact solution. A benchmark knows nothing of how a method maps data. The reconstruction
-//! benchmarks (`scattered`) have no time stepping: a known function sampled at points.
+//! benchmarks (`scattered`) have no time stepping: a known function sampled at points; nor has
+//! `shape_functions`, a grid basis evaluated at points.
 
 mod mms_gong;
 mod mms_tran;
 pub mod scattered;
+pub mod shape_functions;
 mod sine_mms;
 mod vibrating_bar;
 
@@ -85,6 +87,7 @@ const CATALOG: &[BenchmarkInfo] = &[
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
     scattered::INFO_ELEMENTS,
+    shape_functions::INFO,
 ];
 
 /// What a run of a benchmark computes, and so which methods, measures and figures apply.
@@ -99,11 +102,25 @@ pub enum BenchmarkKind {
     /// Sampled data reconstructed element by element (Taylor least squares); errors at
     /// Gauss points.
     Elementwise,
+    /// A grid basis and its gradient evaluated at points, with its consistency errors; no
+    /// data and no time stepping.
+    ShapeFunctions,
 }
 
 impl BenchmarkKind {
+    /// Whether a run reconstructs sampled data (nodal, orthogonal-basis or element-wise).
     pub fn is_reconstruction(self) -> bool {
-        self != BenchmarkKind::Simulation
+        matches!(
+            self,
+            BenchmarkKind::Reconstruction
+                | BenchmarkKind::OrthogonalBasis
+                | BenchmarkKind::Elementwise
+        )
+    }
+
+    /// Whether a run steps in time (only simulations do).
+    pub fn steps(self) -> bool {
+        self == BenchmarkKind::Simulation
     }
 }
 
@@ -114,14 +131,17 @@ impl std::fmt::Display for BenchmarkKind {
             BenchmarkKind::Reconstruction => "nodal reconstruction",
             BenchmarkKind::OrthogonalBasis => "orthogonal-basis reconstruction",
             BenchmarkKind::Elementwise => "element-wise reconstruction",
+            BenchmarkKind::ShapeFunctions => "shape-function evaluation",
         })
     }
 }
 
-/// The kind of a catalogue entry: the reconstruction benchmarks say which they are, every
-/// other benchmark is a simulation.
+/// The kind of a catalogue entry: the reconstruction benchmarks and `shape_functions` say
+/// which they are, every other benchmark is a simulation.
 pub fn kind(info: &BenchmarkInfo) -> BenchmarkKind {
-    scattered::kind(info.name).unwrap_or(BenchmarkKind::Simulation)
+    scattered::kind(info.name)
+        .or_else(|| shape_functions::kind(info.name))
+        .unwrap_or(BenchmarkKind::Simulation)
 }
 
 pub fn catalog() -> &'static [BenchmarkInfo] {

@@ -155,8 +155,10 @@ fn resolve(
         return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
     }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
-    check_method_params(&method, benchmark, &params)
-        .map_err(|e| check_error(e, benchmark, &params, chosen))?;
+    if benchmarks::kind(benchmark.info).steps() {
+        check_method_params(&method, benchmark, &params)
+            .map_err(|e| check_error(e, benchmark, &params, chosen))?;
+    }
     let body = config_body(benchmark.info.name, &method, output_every, &params);
     Ok(RunSpec {
         experiment: experiment.to_string(),

@@ -24,6 +24,7 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("stability", FigureKind::Stability),
         ("growth", FigureKind::Growth),
         ("profile", FigureKind::Profile),
+        ("shape_functions", FigureKind::ShapeFunctions),
     ],
     keys: &["kind", "fields", "norm", "by", "x", "sweep"],
     takes,
@@ -88,13 +89,16 @@ fn takes(kind: &FigureKind) -> &'static [&'static str] {
         FigureKind::Stability => &["x", "sweep"],
         FigureKind::Growth => &["sweep"],
         FigureKind::Profile => &["fields"],
+        FigureKind::ShapeFunctions => &["by"],
     }
 }
 
 /// Whether runs of `benchmark` hold what a figure of `kind` shows.
 fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
     match kind {
-        FigureKind::Convergence => true,
+        // A shape-function run has no grid to refine.
+        FigureKind::Convergence => benchmark != BenchmarkKind::ShapeFunctions,
+        FigureKind::ShapeFunctions => benchmark == BenchmarkKind::ShapeFunctions,
         FigureKind::Reconstruction => benchmark.is_reconstruction(),
         FigureKind::Basis => benchmark == BenchmarkKind::OrthogonalBasis,
         FigureKind::Stability | FigureKind::Growth | FigureKind::Profile => {

@@ -191,6 +191,10 @@ pub enum FigureKind {
     Stability,
     /// Per group: the l2 velocity error over time of the runs on either side of the limit.
     Growth,
+    /// Per group of the axes other than the method and `by`: N_a of the centre node and
+    /// dN_a/dx along the line through it parallel to x, one curve per run, the hat in grey
+    /// (Molinos et al. Fig 3).
+    ShapeFunctions,
 }
 
 #[derive(Clone, Debug, PartialEq)]

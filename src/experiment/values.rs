@@ -3,7 +3,7 @@
 
 use crate::benchmarks::{self, BenchmarkInfo, BenchmarkKind, ParamKind};
 use crate::params::ParamValue;
-use crate::{methods, reconstruction_methods, reference};
+use crate::{methods, reconstruction_methods, reference, shape_methods};
 
 use super::error::ConfigError;
 use super::yaml::{child_field, item_field, Entry, Node, NodeKind};
@@ -21,12 +21,15 @@ pub(crate) enum ValueKind {
 /// The methods a kind of benchmark accepts: MPM presets and reference solvers for
 /// simulations (which benchmark a reference solver solves is checked per run), the
 /// element-wise reconstruction methods for the element-wise benchmark, the local ones for the
-/// other reconstruction benchmarks.
+/// other reconstruction benchmarks, the grid bases for shape-function evaluation.
 pub(crate) fn method_names(kind: BenchmarkKind) -> Vec<&'static str> {
-    if !kind.is_reconstruction() {
+    if kind.steps() {
         let mut names = methods::preset_names();
         names.extend(reference::names());
         return names;
+    }
+    if kind == BenchmarkKind::ShapeFunctions {
+        return shape_methods::method_names();
     }
     let elementwise = kind == BenchmarkKind::Elementwise;
     reconstruction_methods::methods()
@@ -46,10 +49,10 @@ pub(crate) fn settable_kind(
     if entry.key == METHOD_KEY {
         return Ok(ValueKind::Method(benchmarks::kind(info)));
     }
-    let method_params = if benchmarks::kind(info).is_reconstruction() {
-        &[]
-    } else {
+    let method_params = if benchmarks::kind(info).steps() {
         methods::METHOD_PARAMS
+    } else {
+        &[]
     };
     let mut settable = info.params.iter().chain(method_params);
     match settable.clone().find(|p| p.key == entry.key) {
@@ -241,6 +244,11 @@ mod tests {
         assert_eq!(ok, Ok(ParamValue::Str("tls_fitted".into())));
         let e = normalize(elements, &node("shepard"), "params.method").unwrap_err();
         assert_eq!(e.valid, ["tls_fixed", "tls_fitted"]);
+        let bases = ValueKind::Method(BenchmarkKind::ShapeFunctions);
+        let ok = normalize(bases, &node("lme"), "params.method");
+        assert_eq!(ok, Ok(ParamValue::Str("lme".into())));
+        let e = normalize(bases, &node("mpm"), "params.method").unwrap_err();
+        assert_eq!(e.valid, ["lme", "linear", "quadratic_bspline"]);
     }
 
     #[test]

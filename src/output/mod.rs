@@ -27,6 +27,13 @@ pub const RECONSTRUCTION_NORMS: [&str; 2] = ["l2", "max"];
 /// u^h against the exact integral of u.
 pub const ELEMENT_NORMS: [&str; 2] = ["rms", "integral"];
 
+/// The consistency errors of a shape-function run at each point, over the whole basis:
+/// `partition` |sum N_a - 1|, `moment` |sum N_a x_a - x| / h, `gradient` h |sum grad N_a|,
+/// `gradient_moment` |sum grad N_a (x) x_a - I| (Frobenius).
+pub const SHAPE_FIELDS: [&str; 4] = ["partition", "moment", "gradient", "gradient_moment"];
+/// Their norm: the largest over the evaluation points.
+pub const SHAPE_NORMS: [&str; 1] = ["max"];
+
 /// The error fields a kind of run reports, each in each of the norms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Measures {
@@ -48,6 +55,10 @@ impl Measures {
             BenchmarkKind::Elementwise => Measures {
                 fields: &RECONSTRUCTION_FIELDS,
                 norms: &ELEMENT_NORMS,
+            },
+            BenchmarkKind::ShapeFunctions => Measures {
+                fields: &SHAPE_FIELDS,
+                norms: &SHAPE_NORMS,
             },
         }
     }
@@ -117,6 +128,8 @@ pub struct RunSummary {
     pub reconstruction: Option<ReconstructionRecord>,
     /// The `/elements` group of an element-wise reconstruction run, likewise.
     pub elements: Option<ElementRecord>,
+    /// The `/shape_functions` group of a shape-function run, likewise.
+    pub shape_functions: Option<ShapeFunctionRecord>,
     /// The l2 velocity error at every sample of a simulation run that took any.
     pub velocity_history: Option<VelocityHistory>,
     /// The state at the last sample of a 1D simulation run, when the report compares runs
@@ -168,6 +181,7 @@ mod elements;
 mod reader;
 mod reconstruction;
 mod record;
+mod shape_functions;
 mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
@@ -177,4 +191,5 @@ pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,
 };
+pub use shape_functions::ShapeFunctionRecord;
 pub use writer::write_hdf5;

@@ -6,13 +6,16 @@ use hdf5::Location;
 use ndarray::s;
 
 use super::{
-    elements, reconstruction, Profile, RunStatus, RunSummary, VelocityHistory, ERROR_FIELDS, NORMS,
+    elements, reconstruction, shape_functions, Profile, RunStatus, RunSummary, VelocityHistory,
+    ERROR_FIELDS, NORMS,
 };
-use super::{ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
+use super::{
+    ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS, SHAPE_FIELDS, SHAPE_NORMS,
+};
 use crate::params::{ParamValue, Params};
 
-/// Reads what the report needs from one run file. A reconstruction run (nodal or element-wise)
-/// has no time steps: its `steps` is 0 and its `dt` NaN.
+/// Reads what the report needs from one run file. A reconstruction or shape-function run has
+/// no time steps: its `steps` is 0 and its `dt` NaN.
 pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let context = |e: hdf5::Error| format!("{}: {e}", path.display());
     let file = hdf5::File::open(path).map_err(context)?;
@@ -21,20 +24,24 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         .ok_or_else(|| format!("{}: unknown status '{status_text}'", path.display()))?;
     let reconstruction = reconstruction::read(&file).map_err(context)?;
     let elements = elements::read(&file).map_err(context)?;
-    let (final_norms, steps, dt, velocity_history) = match (&reconstruction, &elements) {
-        (Some(r), _) => (
-            unstepped_norms(&RECONSTRUCTION_NORMS, [r.l2, r.max]),
-            0,
-            f64::NAN,
-            None,
-        ),
-        (None, Some(r)) => (
-            unstepped_norms(&ELEMENT_NORMS, [r.rms, r.integral_error]),
-            0,
-            f64::NAN,
-            None,
-        ),
-        (None, None) => (
+    let shape_functions = shape_functions::read(&file).map_err(context)?;
+    let unstepped = match (&reconstruction, &elements, &shape_functions) {
+        (Some(r), _, _) => Some(unstepped_norms(
+            &RECONSTRUCTION_FIELDS,
+            &RECONSTRUCTION_NORMS,
+            &[r.l2, r.max],
+        )),
+        (None, Some(r), _) => Some(unstepped_norms(
+            &RECONSTRUCTION_FIELDS,
+            &ELEMENT_NORMS,
+            &[r.rms, r.integral_error],
+        )),
+        (None, None, Some(r)) => Some(unstepped_norms(&SHAPE_FIELDS, &SHAPE_NORMS, &r.max_errors)),
+        (None, None, None) => None,
+    };
+    let (final_norms, steps, dt, velocity_history) = match unstepped {
+        Some(norms) => (norms, 0, f64::NAN, None),
+        None => (
             simulation_norms(&file).map_err(context)?,
             read_i64(&file, "steps").map_err(context)? as usize,
             read_f64(&file, "dt").map_err(context)?,
@@ -60,6 +67,7 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         final_norms,
         reconstruction,
         elements,
+        shape_functions,
         velocity_history,
         profile: None,
     })
@@ -139,13 +147,15 @@ fn simulation_norms(file: &hdf5::File) -> hdf5::Result<FinalNorms> {
     Ok(final_norms)
 }
 
-/// The error of u in each of the norms of a run that does not step.
-fn unstepped_norms(norms: &[&str; 2], values: [f64; 2]) -> FinalNorms {
-    let [field] = RECONSTRUCTION_FIELDS;
-    norms
+/// The final norms of a run that does not step: `values` holds every field in every norm,
+/// norms fastest.
+fn unstepped_norms(fields: &[&str], norms: &[&str], values: &[f64]) -> FinalNorms {
+    let pairs = fields
         .iter()
+        .flat_map(|field| norms.iter().map(move |norm| (field, norm)));
+    pairs
         .zip(values)
-        .map(|(norm, value)| ((field.to_string(), norm.to_string()), value))
+        .map(|((field, norm), &value)| ((field.to_string(), norm.to_string()), value))
         .collect()
 }
 

@@ -1,4 +1,4 @@
-use super::{ElementRecord, ReconstructionRecord, RunStatus};
+use super::{ElementRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
@@ -28,6 +28,8 @@ pub struct RunRecord {
     pub reconstruction: Option<ReconstructionRecord>,
     /// Set instead for the runs of the element-wise reconstruction benchmark.
     pub elements: Option<ElementRecord>,
+    /// Set instead for the runs of the shape-function benchmark.
+    pub shape_functions: Option<ShapeFunctionRecord>,
 }
 
 /// The root attributes `shape`, `transfer` and `integrator`: what the run's method is made of.

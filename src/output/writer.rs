@@ -4,7 +4,7 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
-use super::{elements, reconstruction, RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
+use super::{elements, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
 use crate::params::ParamValue;
 
 /// Writes the whole record into a new HDF5 file at `path` (which must not exist).
@@ -17,6 +17,10 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     }
     if let Some(record) = &r.elements {
         elements::write(&file, record)?;
+        return file.flush();
+    }
+    if let Some(record) = &r.shape_functions {
+        shape_functions::write(&file, record)?;
         return file.flush();
     }
     let d = r.dim;

@@ -9,8 +9,9 @@ use super::format::{general, rate};
 use super::group::{self, label, ordered_runs};
 use super::pointwise::Table;
 use super::RateRow;
+use crate::benchmarks::BenchmarkKind;
 use crate::experiment::Experiment;
-use crate::output::{RunStatus, RunSummary, REFERENCE_NORM};
+use crate::output::{RunStatus, RunSummary, REFERENCE_NORM, SHAPE_FIELDS};
 
 pub fn report_md(
     experiment: &Experiment,
@@ -28,7 +29,11 @@ pub fn report_md(
     overview(&mut md, experiment, &runs);
     runs_table(&mut md, experiment, &runs);
     reference_table(&mut md, experiment, &runs);
-    rates_table(&mut md, rates);
+    if experiment.kind == BenchmarkKind::ShapeFunctions {
+        consistency_table(&mut md, experiment, &runs);
+    } else {
+        rates_table(&mut md, rates);
+    }
     unfinished(&mut md, experiment, &runs);
     if !tables.is_empty() {
         md.push_str("## Tables\n\n");
@@ -76,7 +81,7 @@ fn overview(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
 fn runs_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
     md.push_str("## Runs\n\n");
     // Reconstruction runs take no time steps.
-    let stepped = !experiment.kind.is_reconstruction();
+    let stepped = experiment.kind.steps();
     let mut header = vec!["run".to_string()];
     header.extend(experiment.axes.iter().cloned());
     header.extend(["h", "status"].map(String::from));
@@ -132,6 +137,35 @@ fn reference_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary
                 .map_or_else(String::new, |&e| general(e, 4))
         }));
         row
+    });
+    table(md, &header, rows);
+}
+
+/// The largest consistency errors of each shape-function run over its points, and how LME's
+/// Newton iterations went.
+fn consistency_table(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
+    md.push_str(
+        "## Consistency of the bases
+
+",
+    );
+    md.push_str(
+        "Largest over the evaluation points, the sums over every node of each point's \
+         stencil: partition |sum N_a - 1|, moment |sum N_a x_a - x| / h, gradient \
+         h |sum grad N_a|, gradient_moment |sum grad N_a (x) x_a - I| (Frobenius); then the \
+         LME points where Newton stopped short and the most Newton steps at any point.\n\n",
+    );
+    let mut header = vec!["run".to_string()];
+    header.extend(experiment.axes.iter().cloned());
+    header.extend(SHAPE_FIELDS.map(String::from));
+    header.extend(["Newton failures", "most Newton steps"].map(String::from));
+    let rows = runs.iter().filter_map(|run| {
+        let record = run.shape_functions.as_ref()?;
+        let mut row = vec![format!("`{}`", run.run_id)];
+        row.extend(group::axis_values(experiment, run));
+        row.extend(record.max_errors.map(|e| general(e, 3)));
+        row.extend([record.failures, record.max_newton_steps].map(|n| n.to_string()));
+        Some(row)
     });
     table(md, &header, rows);
 }

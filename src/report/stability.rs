@@ -281,6 +281,7 @@ mod tests {
             final_norms: BTreeMap::new(),
             reconstruction: None,
             elements: None,
+            shape_functions: None,
             velocity_history: Some(VelocityHistory {
                 time: (0..errors.len()).map(|k| k as f64).collect(),
                 l2_error: errors.to_vec(),

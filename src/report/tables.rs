@@ -25,7 +25,7 @@ const RATE_COLUMNS: [&str; 10] = [
 /// (for simulations), every final error norm, then the message (last, as it is the field
 /// most likely to need quoting).
 pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
-    let stepped = !experiment.kind.is_reconstruction();
+    let stepped = experiment.kind.steps();
     let measures = experiment.measures();
     let mut header: Vec<String> = vec!["run_id".into()];
     header.extend(experiment.axes.iter().cloned());

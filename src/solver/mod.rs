@@ -1,16 +1,18 @@
 //! One run: build the problem, seed particles, step, sample, and return the record. Runs of
-//! reconstruction benchmarks, which do not step, go to `reconstruction`.
+//! reconstruction benchmarks, which do not step, go to `reconstruction`, and those of the
+//! shape-function benchmark to `shape_functions`.
 
 mod reconstruction;
 mod recorder;
 mod reference;
+mod shape_functions;
 mod transfer;
 
 use std::time::Instant;
 
 use nalgebra::SVector;
 
-use crate::benchmarks::{self, AnyProblem, Problem};
+use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
 use crate::experiment::RunSpec;
 use crate::integrate::predictor_corrector::CarriedVelocity;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
@@ -30,10 +32,11 @@ use transfer::Transfer;
 /// `failed`, a run that blows up is `diverged`, each with the reason in `message`.
 pub fn simulate(spec: &RunSpec) -> RunRecord {
     let started = Instant::now();
-    let is_reconstruction = benchmarks::info(&spec.benchmark)
-        .is_some_and(|info| benchmarks::kind(info).is_reconstruction());
-    let mut record = if is_reconstruction {
+    let kind = benchmarks::info(&spec.benchmark).map(benchmarks::kind);
+    let mut record = if kind.is_some_and(BenchmarkKind::is_reconstruction) {
         reconstruction::evaluate(spec)
+    } else if kind == Some(BenchmarkKind::ShapeFunctions) {
+        shape_functions::evaluate(spec)
     } else if crate::reference::method(&spec.method).is_some() {
         reference::solve(spec)
     } else {
@@ -491,5 +494,6 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         diagnostics: Default::default(),
         reconstruction: None,
         elements: None,
+        shape_functions: None,
     }
 }

@@ -15,6 +15,12 @@ seeded generator), the sampled function, u^h by an independent weighted least-sq
 (Gram-Schmidt on value vectors), the l2 and max norms, and the orthogonal basis with its
 <p_i, p_i>.
 
+Shape-function runs (shape_functions) have a /shape_functions group instead. For them it
+recomputes the lattice of evaluation points and the recorded nodes, and N_a and grad N_a of
+those nodes by a second implementation: the hat by its formula, the local maximum-entropy basis
+by a damped Newton solve in numpy (on a face of the grid by the LME of the face's nodes alone,
+the limit the kernel approaches), and checks the stored maxima of the consistency errors.
+
 Element-wise runs (recon_tls) have an /elements group instead. For them it recomputes the
 elements, the data points of each, the Gauss points and weights (numpy's Gauss-Legendre rule),
 u there, each element's Taylor least-squares fit (numpy's SVD least squares, the element mean
@@ -178,9 +184,14 @@ class Run:
         return "/elements" in self.groups
 
     @property
+    def is_shape_functions(self):
+        return "/shape_functions" in self.groups
+
+    @property
     def is_unstepped(self):
-        """Reconstruction runs, nodal or element-wise, take no time steps."""
-        return self.is_reconstruction or self.is_elements
+        """Reconstruction runs, nodal or element-wise, and shape-function runs take no time
+        steps."""
+        return self.is_reconstruction or self.is_elements or self.is_shape_functions
 
     def has_data(self):
         """A failed run may stop before any state exists; every other run has all datasets."""
@@ -202,6 +213,10 @@ class Run:
     def require_elements(self):
         if not self.is_elements:
             pytest.skip("no /elements group")
+
+    def require_shape_functions(self):
+        if not self.is_shape_functions:
+            pytest.skip("no /shape_functions group")
 
     def param(self, key):
         params = self.group("/params")
@@ -262,6 +277,8 @@ def test_root_attributes(run):
         assert a["dim"] == 1 and a["ppc"] >= 0
     elif run.is_elements:
         assert a["dim"] in (1, 2) and a["ppc"] >= 1
+    elif run.is_shape_functions:
+        assert a["dim"] in (1, 2) and a["ppc"] == 0 and a["h"] == 1.0
     else:
         assert a["ppc"] >= 1 and a["steps"] >= 0
         assert a["dt"] > 0 and a["t_end"] > 0
@@ -463,7 +480,7 @@ def test_conservation(run):
 
 def test_diagnostics(run):
     if run.is_unstepped:
-        pytest.skip("reconstruction run: its fit counters are in /reconstruction or /elements")
+        pytest.skip("run without particles: its counters are in its own group")
     counters = run.group("/diagnostics")
     for name in DIAGNOSTICS:
         assert name in counters, f"/diagnostics has no attribute {name}"
@@ -1106,3 +1123,165 @@ def test_element_fits_by_a_second_implementation(run):
                                    err_msg=f"u^h at {where}")
     curve_x = run.ds("/elements/curve_x")
     np.testing.assert_allclose(run.ds("/elements/curve_exact"), u(curve_x), rtol=0, atol=1e-14)
+
+
+# --------------------------------------------------------------------------------------------
+# Shape-function runs: the lattice, the recorded nodes, and N_a and grad N_a by a second
+# implementation of the hat and of the local maximum-entropy basis.
+
+SHAPE_FIELDS = ("partition", "moment", "gradient", "gradient_moment")
+SHAPE_BASES = ("lme", "linear", "quadratic_bspline")
+# Recorded neighbours of the centre node on each side along x.
+SHAPE_NEIGHBOURS = 2
+# Newton's residual tolerance in units of h (the kernel's RESIDUAL_TOLERANCE).
+LME_RESIDUAL = 1e-12
+
+
+def shape_lattice(run):
+    """The evaluation points: `points` per cell and axis on [0, cells], x fastest."""
+    p = run.group("/params")
+    cells, per_cell, d = int(p["cells"]), int(p["points"]), int(p["dim"])
+    axis = np.arange(cells * per_cell + 1) / per_cell
+    grids = np.meshgrid(*([axis] * d), indexing="ij")
+    return np.stack([g.ravel(order="F") for g in grids], axis=1), cells
+
+
+def grid_nodes(cells, d):
+    """The grid nodes, x fastest."""
+    axis = np.arange(cells + 1, dtype=float)
+    grids = np.meshgrid(*([axis] * d), indexing="ij")
+    return np.stack([g.ravel(order="F") for g in grids], axis=1)
+
+
+def hat(x, nodes):
+    """N_a(x) and grad N_a(x) of the tensor-product hat on unit cells."""
+    t = 1.0 - np.abs(x - nodes)
+    inside = np.all(t > 0, axis=1)
+    t = np.where(inside[:, None], t, 0.0)
+    n = np.prod(t, axis=1)
+    sign = -np.sign(x - nodes)
+    grad = np.stack([sign[:, k] * np.prod(np.delete(t, k, axis=1), axis=1)
+                     for k in range(nodes.shape[1])], axis=1)
+    return n, grad * inside[:, None]
+
+
+def lme(x, nodes, gamma, tolerance, cells):
+    """N_a(x) and grad N_a(x) of the LME basis by a damped Newton solve for the multiplier;
+    on a face the LME of the face's nodes, whose gradient normal to the face is left NaN (the
+    kernel's is that of its last iterate, the limit it approaches)."""
+    d = x - nodes
+    near = np.sum(d**2, axis=1) <= -np.log(tolerance) / gamma
+    on_face = (x == 0) | (x == cells)
+    support = near & np.all(np.abs(d[:, on_face]) == 0, axis=1)
+    free = ~on_face
+    offsets = d[support][:, free]
+    weights = np.zeros(len(nodes))
+    grad = np.zeros_like(nodes)
+    grad[:, on_face] = np.nan
+    if offsets.shape[1] == 0:
+        weights[support] = 1.0
+        return weights, grad
+    prior = -gamma * np.sum(offsets**2, axis=1)
+
+    def moments(mu):
+        f = prior + offsets @ mu
+        top = f.max()
+        p = np.exp(f - top)
+        z = p.sum()
+        p /= z
+        r = p @ offsets
+        c = offsets - r
+        return top + np.log(z), p, r, (c * p[:, None]).T @ c
+
+    mu = np.zeros(offsets.shape[1])
+    log_z, p, r, j = moments(mu)
+    for _ in range(200):
+        if np.linalg.norm(r) < LME_RESIDUAL / 10:
+            break
+        step = -np.linalg.solve(j, r)
+        alpha = 1.0
+        while alpha > 1e-12:
+            trial = moments(mu + alpha * step)
+            if trial[0] <= log_z + 1e-4 * alpha * (r @ step) + 1e-13 * (1 + abs(log_z)):
+                break
+            alpha /= 2
+        mu = mu + alpha * step
+        log_z, p, r, j = trial
+    weights[support] = p
+    block = -(np.linalg.solve(j, (offsets - r).T).T) * p[:, None]
+    grad[np.ix_(support, free)] = block
+    return weights, grad
+
+
+def test_shape_functions_layout(run):
+    run.require_shape_functions()
+    a, g = run.attrs, run.group("/shape_functions")
+    assert a["benchmark"] == "shape_functions"
+    assert g["basis"] == a["method"] and g["basis"] in SHAPE_BASES
+    for name in ("gamma", "tolerance", "radius") + tuple(f"max_{f}_error" for f in SHAPE_FIELDS):
+        assert isinstance(g.get(name), (float, np.floating)), f"/shape_functions {name}"
+    for name in ("centre", "failures", "max_newton_steps"):
+        assert isinstance(g.get(name), (int, np.integer)), f"/shape_functions {name}"
+    x = run.ds("/shape_functions/x")
+    n_p, d = x.shape
+    nodes = run.ds("/shape_functions/nodes")
+    n_n = len(nodes)
+    shapes = {
+        "x": (n_p, d), "nodes": (n_n,), "node_x": (n_n, d), "value": (n_p, n_n),
+        "gradient": (n_p, n_n, d),
+    }
+    shapes.update({f"{f}_error": (n_p,) for f in SHAPE_FIELDS})
+    for name, shape in shapes.items():
+        arr = run.ds(f"/shape_functions/{name}")
+        assert arr.shape == shape, f"/shape_functions/{name} has shape {arr.shape}, not {shape}"
+        assert run.units[f"/shape_functions/{name}"] == "1"
+    assert np.issubdtype(nodes.dtype, np.integer)
+    assert d == a["dim"] == run.group("/params")["dim"]
+    if run.status != "ok":
+        pytest.skip("the run did not complete")
+    expected_x, cells = shape_lattice(run)
+    np.testing.assert_array_equal(x, expected_x, err_msg="evaluation points")
+    for f in SHAPE_FIELDS:
+        errors = run.ds(f"/shape_functions/{f}_error")
+        assert g[f"max_{f}_error"] == errors.max(), f"max_{f}_error is not the largest"
+    assert g["failures"] == 0, "an ok run had Newton failures"
+    if g["basis"] == "lme":
+        radius = np.sqrt(-np.log(g["tolerance"]) / g["gamma"])
+        np.testing.assert_allclose(g["radius"], radius, rtol=1e-15)
+        assert 0 < g["max_newton_steps"] <= 100
+    else:
+        assert np.isnan(g["gamma"]) and g["max_newton_steps"] == 0
+
+
+def test_shape_functions_by_a_second_implementation(run):
+    run.require_shape_functions()
+    g = run.group("/shape_functions")
+    if run.status != "ok" or g["basis"] == "quadratic_bspline":
+        pytest.skip("no second implementation of this basis, or the run did not complete")
+    x, cells = shape_lattice(run)
+    d = x.shape[1]
+    nodes = grid_nodes(cells, d)
+    centre = np.full(d, cells // 2)
+    i = centre[0]
+    along = np.arange(max(i - SHAPE_NEIGHBOURS, 0), min(i + SHAPE_NEIGHBOURS + 1, cells + 1))
+    expected_nodes = [int(k + (cells + 1) * centre[1]) if d == 2 else int(k) for k in along]
+    np.testing.assert_array_equal(run.ds("/shape_functions/nodes"), expected_nodes)
+    np.testing.assert_array_equal(run.ds("/shape_functions/node_x"), nodes[expected_nodes])
+    assert int(g["centre"]) == list(along).index(i)
+    value = run.ds("/shape_functions/value")
+    gradient = run.ds("/shape_functions/gradient")
+    for p in range(len(x)):
+        if g["basis"] == "linear":
+            n, grad = hat(x[p], nodes)
+            # At a cell face the hat's gradient is one-sided: the kernel takes the upper cell.
+            if np.any(np.isclose(x[p] % 1.0, 0.0)):
+                grad = None
+        else:
+            n, grad = lme(x[p], nodes, g["gamma"], g["tolerance"], cells)
+        np.testing.assert_allclose(value[p], n[expected_nodes], rtol=0, atol=1e-10,
+                                   err_msg=f"N_a at {x[p]}")
+        if grad is not None:
+            expected = grad[expected_nodes]
+            known = ~np.isnan(expected)
+            np.testing.assert_allclose(gradient[p][known], expected[known], rtol=0, atol=1e-8,
+                                       err_msg=f"grad N_a at {x[p]}")

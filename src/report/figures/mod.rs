@@ -3,12 +3,14 @@
 mod along_bar;
 mod convergence;
 mod profiles;
+mod shape_functions;
 mod stability;
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use super::group::{selects, slug};
+use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{Experiment, FigureKind, FigureSpec};
 use crate::output::RunSummary;
 use crate::params::Params;
@@ -76,13 +78,18 @@ pub struct Figure {
     pub series: Vec<Series>,
 }
 
-/// Every figure of the report: the experiment's own, or one convergence figure per group
-/// with all fields in the first norm when it asks for none. Figures without a single
-/// usable point are left out.
+/// Every figure of the report: the experiment's own, or when it asks for none one convergence
+/// figure per group with all fields in the first norm (the shape-function figures for a
+/// shape-function benchmark, which does not refine). Figures without a single usable point
+/// are left out.
 pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
     let measures = experiment.measures();
     let default = [FigureSpec {
-        kind: FigureKind::Convergence,
+        kind: if experiment.kind == BenchmarkKind::ShapeFunctions {
+            FigureKind::ShapeFunctions
+        } else {
+            FigureKind::Convergence
+        },
         fields: measures.fields.iter().map(|f| f.to_string()).collect(),
         norm: measures.norms[0].to_string(),
         by: None,
@@ -118,6 +125,9 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
             )),
             FigureKind::Profile => figures.extend(along_bar::figures(
                 experiment, runs, &selected, spec, &mut names,
+            )),
+            FigureKind::ShapeFunctions => figures.extend(shape_functions::figures(
+                experiment, &selected, spec, &mut names,
             )),
         }
     }

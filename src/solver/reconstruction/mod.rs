@@ -208,7 +208,7 @@ fn fit_nodes(
 }
 
 /// The larger of two numbers, NaN if either is (`f64::max` would drop the NaN).
-fn nan_max(a: f64, b: f64) -> f64 {
+pub(super) fn nan_max(a: f64, b: f64) -> f64 {
     if a.is_nan() || b.is_nan() {
         f64::NAN
     } else {

@@ -1,0 +1,66 @@
+//! The catalogue of grid bases, the `method` of the `shape_functions` benchmark: the LME basis
+//! of Molinos et al. and, for comparison, the hat it tends to for large gamma and the quadratic
+//! B-spline.
+
+use std::fmt;
+
+/// Which basis a method evaluates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Basis {
+    /// Local maximum entropy with the run's gamma and tolerance.
+    Lme,
+    /// The piecewise-linear hat.
+    Linear,
+    /// The quadratic B-spline, its DOFs at the Greville abscissae.
+    QuadraticBSpline,
+}
+
+impl fmt::Display for Basis {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Basis::Lme => "lme",
+            Basis::Linear => "linear",
+            Basis::QuadraticBSpline => "quadratic_bspline",
+        })
+    }
+}
+
+pub struct ShapeMethod {
+    pub name: &'static str,
+    pub basis: Basis,
+    pub source: &'static str,
+    pub description: &'static str,
+}
+
+const METHODS: &[ShapeMethod] = &[
+    ShapeMethod {
+        name: "lme",
+        basis: Basis::Lme,
+        source: "Molinos et al., sec 5, eqs 32-38",
+        description: "local maximum-entropy basis, locality gamma and cut-off tolerance",
+    },
+    ShapeMethod {
+        name: "linear",
+        basis: Basis::Linear,
+        source: "Gong 2015, eq 4.8",
+        description: "piecewise-linear hat (tensor product in 2D)",
+    },
+    ShapeMethod {
+        name: "quadratic_bspline",
+        basis: Basis::QuadraticBSpline,
+        source: "Steffen et al. 2008; Wobbes et al. 2018",
+        description: "quadratic B-spline on the open knot vector",
+    },
+];
+
+pub fn methods() -> &'static [ShapeMethod] {
+    METHODS
+}
+
+pub fn method(name: &str) -> Option<&'static ShapeMethod> {
+    METHODS.iter().find(|m| m.name == name)
+}
+
+pub fn method_names() -> Vec<&'static str> {
+    METHODS.iter().map(|m| m.name).collect()
+}
