@@ -62,6 +62,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         elements: None,
         velocity_history: None,
         profile: None,
+        probes: Vec::new(),
     }
 }
 

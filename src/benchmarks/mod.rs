@@ -12,6 +12,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::material::Material;
 use crate::params::{ParamError, ParamValue, Params};
+use crate::particles::Placement;
 
 pub use mms_gong::{gong_mms, thesis_params};
 pub use sine_mms::SineMms;
@@ -145,6 +146,72 @@ pub struct ExactState<const D: usize> {
     pub density: f64,
 }
 
+/// What a probe records at its particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProbeQuantity {
+    Displacement(usize),
+    Velocity(usize),
+    Stress(usize, usize),
+}
+
+impl ProbeQuantity {
+    /// The quantity's name in the run file (`/probes/<name>` attribute `quantity`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ProbeQuantity::Displacement(_) => "displacement",
+            ProbeQuantity::Velocity(_) => "velocity",
+            ProbeQuantity::Stress(..) => "stress",
+        }
+    }
+
+    /// The component: one index for a vector, row and column for the stress.
+    pub fn component(self) -> Vec<usize> {
+        match self {
+            ProbeQuantity::Displacement(k) | ProbeQuantity::Velocity(k) => vec![k],
+            ProbeQuantity::Stress(i, j) => vec![i, j],
+        }
+    }
+
+    /// The quantity's value in a state: displacement, velocity and Cauchy stress.
+    pub fn of<const D: usize>(
+        self,
+        displacement: &SVector<f64, D>,
+        velocity: &SVector<f64, D>,
+        stress: &SMatrix<f64, D, D>,
+    ) -> f64 {
+        match self {
+            ProbeQuantity::Displacement(k) => displacement[k],
+            ProbeQuantity::Velocity(k) => velocity[k],
+            ProbeQuantity::Stress(i, j) => stress[(i, j)],
+        }
+    }
+}
+
+/// A quantity recorded at one particle every step (Molinos et al. Figs 5-13): the particle whose
+/// reference position is nearest `at` (ties: the lowest index).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe<const D: usize> {
+    pub name: &'static str,
+    pub at: SVector<f64, D>,
+    pub quantity: ProbeQuantity,
+}
+
+impl<const D: usize> Probe<D> {
+    /// The index of the particle nearest `at` among the reference positions `x0`; `None` when
+    /// there are none.
+    pub fn nearest(&self, x0: &[SVector<f64, D>]) -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for (p, x) in x0.iter().enumerate() {
+            let d = (x - self.at).norm_squared();
+            // Strictly nearer only, so a tie keeps the lower index.
+            if best.is_none_or(|(_, b)| d < b) {
+                best = Some((p, d));
+            }
+        }
+        best.map(|(p, _)| p)
+    }
+}
+
 /// A uniform background grid over a box, `cells` cells per direction.
 #[derive(Clone, Copy, Debug)]
 pub struct Domain<const D: usize> {
@@ -175,6 +242,18 @@ pub trait Problem<const D: usize>: Send + Sync {
     /// Prepare `body_force` for these reference positions (called once before stepping).
     fn attach_particles(&mut self, x0: &[SVector<f64, D>]);
     fn exact(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>>;
+    /// Where the particles are seeded inside each cell.
+    fn placement(&self) -> Placement {
+        Placement::SubCellCentres
+    }
+    fn probes(&self) -> Vec<Probe<D>> {
+        Vec::new()
+    }
+    /// The solution a probe is drawn against: the exact one where there is one; a benchmark without one
+    /// may give another reference (the quasi-static solution of the Andersen block).
+    fn probe_reference(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>> {
+        self.exact(x0, t)
+    }
 }
 
 /// A problem of either supported dimension.

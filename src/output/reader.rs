@@ -6,7 +6,8 @@ use hdf5::Location;
 use ndarray::s;
 
 use super::{
-    elements, reconstruction, Profile, RunStatus, RunSummary, VelocityHistory, ERROR_FIELDS, NORMS,
+    elements, probes, reconstruction, ProbeRecord, Profile, RunStatus, RunSummary, VelocityHistory,
+    ERROR_FIELDS, NORMS,
 };
 use super::{ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS};
 use crate::params::{ParamValue, Params};
@@ -62,7 +63,15 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         elements,
         velocity_history,
         profile: None,
+        probes: Vec::new(),
     })
+}
+
+/// The `/probes` of a run file (none for a run without them).
+pub fn read_probes(path: &Path) -> Result<Vec<ProbeRecord>, String> {
+    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
+    let file = hdf5::File::open(path).map_err(context)?;
+    probes::read(&file).map_err(context)
 }
 
 /// The last sample of a 1D simulation run; `None` for a run without samples.
