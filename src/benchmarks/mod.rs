@@ -2,6 +2,7 @@
 //! exact solution. A benchmark knows nothing of how a method maps data. The reconstruction
 //! benchmarks (`scattered`) have no time stepping: a known function sampled at points.
 
+mod dyka_bar;
 mod mms_gong;
 mod mms_tran;
 pub mod scattered;
@@ -83,6 +84,7 @@ const CATALOG: &[BenchmarkInfo] = &[
     mms_gong::INFO_2D,
     mms_tran::INFO,
     vibrating_bar::INFO,
+    dyka_bar::INFO,
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
     scattered::INFO_ELEMENTS,
@@ -196,6 +198,10 @@ pub struct Probe<const D: usize> {
     pub quantity: ProbeQuantity,
 }
 
+/// Squared distances closer than this (relative) are a tie: equidistant particles differ by
+/// rounding only.
+const TIE_TOLERANCE: f64 = 1e-9;
+
 impl<const D: usize> Probe<D> {
     /// The index of the particle nearest `at` among the reference positions `x0`; `None` when
     /// there are none.
@@ -203,8 +209,8 @@ impl<const D: usize> Probe<D> {
         let mut best: Option<(usize, f64)> = None;
         for (p, x) in x0.iter().enumerate() {
             let d = (x - self.at).norm_squared();
-            // Strictly nearer only, so a tie keeps the lower index.
-            if best.is_none_or(|(_, b)| d < b) {
+            // Nearer by more than rounding only, so a tie keeps the lower index.
+            if best.is_none_or(|(_, b)| d < b * (1.0 - TIE_TOLERANCE)) {
                 best = Some((p, d));
             }
         }
@@ -269,6 +275,7 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
         "mms2d_gong" => Ok(AnyProblem::D2(Box::new(gong_mms::<2>(params)?))),
         "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
         "vibrating_bar" => Ok(AnyProblem::D1(Box::new(vibrating_bar(params)?))),
+        "dyka_bar" => Ok(AnyProblem::D1(Box::new(dyka_bar::dyka_bar(params)?))),
         other => Err(ParamError::new(
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),
