@@ -2,6 +2,7 @@
 //! exact solution. A benchmark knows nothing of how a method maps data. The reconstruction
 //! benchmarks (`scattered`) have no time stepping: a known function sampled at points.
 
+mod andersen_block;
 mod dyka_bar;
 mod mms_gong;
 mod mms_tran;
@@ -85,6 +86,7 @@ const CATALOG: &[BenchmarkInfo] = &[
     mms_tran::INFO,
     vibrating_bar::INFO,
     dyka_bar::INFO,
+    andersen_block::INFO,
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
     scattered::INFO_ELEMENTS,
@@ -276,6 +278,9 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
         "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
         "vibrating_bar" => Ok(AnyProblem::D1(Box::new(vibrating_bar(params)?))),
         "dyka_bar" => Ok(AnyProblem::D1(Box::new(dyka_bar::dyka_bar(params)?))),
+        "andersen_block" => Ok(AnyProblem::D2(Box::new(andersen_block::andersen_block(
+            params,
+        )?))),
         other => Err(ParamError::new(
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),
