@@ -2,6 +2,7 @@
 
 mod along_bar;
 mod convergence;
+mod history;
 mod profiles;
 mod stability;
 
@@ -27,6 +28,8 @@ pub enum Scale {
 pub enum Marker {
     Circle,
     Square,
+    /// Where a diverged run stopped.
+    Cross,
 }
 
 /// One legend entry: markers at some points and a line through others, in one colour.
@@ -78,8 +81,8 @@ pub struct Figure {
 
 /// Every figure of the report: the experiment's own, or one convergence figure per group
 /// with all fields in the first norm when it asks for none. Figures without a single
-/// usable point are left out.
-pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
+/// usable point are left out. A history figure of a probe no run records is an error.
+pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>, String> {
     let measures = experiment.measures();
     let default = [FigureSpec {
         kind: FigureKind::Convergence,
@@ -88,6 +91,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
         by: None,
         select: Params::new(),
         stability: None,
+        probe: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -119,9 +123,12 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
             FigureKind::Profile => figures.extend(along_bar::figures(
                 experiment, runs, &selected, spec, &mut names,
             )),
+            FigureKind::History => {
+                figures.extend(history::figures(experiment, &selected, spec, &mut names)?)
+            }
         }
     }
-    figures
+    Ok(figures)
 }
 
 /// File names already given out: two figures may land on the same stem, and later ones get
