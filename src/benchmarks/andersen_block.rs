@@ -110,7 +110,8 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "andersen_block",
     dim: 2,
     source: "Molinos et al., sec 6.2, eq 41 (Andersen 2009)",
-    description: "elastic block on a rigid base under gravity ramped up by eq 41",
+    description: "elastic block on a rigid base under gravity ramped up by eq 41; probes \
+                  top_displacement, bottom_stress",
     params: PARAMS,
     check: check_params,
 };

@@ -86,7 +86,8 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "dyka_bar",
     dim: 1,
     source: "Molinos et al., sec 6.1, appendix A (Dyka & Ingel 1995)",
-    description: "linear-elastic bar, x = 0 fixed, x = L free, v0 on the last quarter",
+    description: "linear-elastic bar, x = 0 fixed, x = L free, v0 on the last quarter; probes \
+                  free_end_velocity, mid_stress",
     params: PARAMS,
     check: check_params,
 };
