@@ -13,8 +13,8 @@ use std::f64::consts::PI;
 
 use nalgebra::{SMatrix, SVector, Vector2};
 
+use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem};
 use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
-use super::{ParamError, Params, Probe, ProbeQuantity, Problem};
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_str, get_usize};
 use crate::particles::Placement;
@@ -117,13 +117,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
 };
 
 fn check_params(params: &Params) -> Result<(), ParamError> {
-    let cfl = get_f64(params, "cfl")?;
-    if cfl > 1.0 {
-        return Err(ParamError::new(
-            "cfl",
-            format!("cfl = {cfl} > 1 makes the explicit scheme unstable; use cfl <= 1"),
-        ));
-    }
+    courant_number(params)?;
     let block = AndersenBlock::new(params)?;
     let strain = block.rho0 * block.gravity.abs() * block.height / block.young;
     if strain >= 1.0 {
@@ -181,10 +175,6 @@ impl AndersenBlock {
         })
     }
 
-    fn h(&self) -> f64 {
-        self.height / self.cells as f64
-    }
-
     /// Eq 41: 0.5 g (sin(2 pi t / T - pi / 2) + 1) until T/2, then g; the ramp starts at 0 with
     /// zero slope and meets g with zero slope.
     fn gravity_at(&self, t: f64) -> f64 {
@@ -204,12 +194,7 @@ pub fn andersen_block(params: &Params) -> Result<AndersenBlock, ParamError> {
 
 impl Problem<2> for AndersenBlock {
     fn domain(&self) -> Domain<2> {
-        let cells = self.cells + self.extra_cells;
-        Domain {
-            lower: SVector::zeros(),
-            upper: SVector::repeat(cells as f64 * self.h()),
-            cells,
-        }
+        Domain::padded(self.height, self.cells, self.extra_cells)
     }
 
     fn body(&self) -> (SVector<f64, 2>, SVector<f64, 2>) {
@@ -226,10 +211,7 @@ impl Problem<2> for AndersenBlock {
 
     /// nu = 0, so lambda = 0 and 2 mu = E.
     fn material(&self) -> Material {
-        Material::LinearElasticRate(LinearElasticRate {
-            lambda: 0.0,
-            mu: 0.5 * self.young,
-        })
+        Material::LinearElasticRate(LinearElasticRate::without_poisson(self.young))
     }
 
     fn dt(&self) -> f64 {
@@ -298,6 +280,10 @@ impl Problem<2> for AndersenBlock {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn cell(b: &AndersenBlock) -> f64 {
+        b.height / b.cells as f64
+    }
     use crate::benchmarks::{catalog, default_params};
     use crate::params::ParamValue;
     use crate::particles::Particles;
@@ -315,7 +301,7 @@ mod tests {
     fn is_in_the_catalogue_with_the_papers_grid() {
         assert!(catalog().iter().any(|b| b.name == "andersen_block"));
         let b = block(&[]);
-        assert_eq!(b.h(), 2.0);
+        assert_eq!(cell(&b), 2.0);
         let domain = b.domain();
         assert_eq!(domain.cells, 6);
         assert_eq!(domain.upper, Vector2::repeat(12.0));
@@ -372,7 +358,7 @@ mod tests {
             let grid = Grid::new(&b.domain());
             let particles = Particles::seed(&b, &grid);
             assert_eq!(particles.len(), 100);
-            let h = b.h();
+            let h = cell(&b);
             for (p, x) in particles.x0.iter().enumerate() {
                 for k in 0..2 {
                     let cell = (x[k] / h).floor();

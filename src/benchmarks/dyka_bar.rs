@@ -11,8 +11,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::sine_mms::fit_time_step;
+use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem};
 use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
-use super::{ParamError, Params, Probe, ProbeQuantity, Problem};
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_usize};
 
@@ -95,13 +95,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
 /// The explicit scheme's Courant bound, and a strain that keeps the exact density finite.
 fn check_params(params: &Params) -> Result<(), ParamError> {
     let bar = DykaBar::new(params)?;
-    let cfl = get_f64(params, "cfl")?;
-    if cfl > 1.0 {
-        return Err(ParamError::new(
-            "cfl",
-            format!("cfl = {cfl} > 1 makes the explicit scheme unstable; use cfl <= 1"),
-        ));
-    }
+    courant_number(params)?;
     let strain = bar.v0.abs() / bar.wave_speed();
     if strain >= 1.0 {
         return Err(ParamError::new(
@@ -152,10 +146,6 @@ impl DykaBar {
 
     fn wave_speed(&self) -> f64 {
         (self.young / self.rho0).sqrt()
-    }
-
-    fn h(&self) -> f64 {
-        self.length / self.cells as f64
     }
 
     /// The initial velocity on [0, L]: v0 on the last quarter.
@@ -212,12 +202,7 @@ pub fn dyka_bar(params: &Params) -> Result<DykaBar, ParamError> {
 
 impl Problem<1> for DykaBar {
     fn domain(&self) -> Domain<1> {
-        let cells = self.cells + self.extra_cells;
-        Domain {
-            lower: SVector::zeros(),
-            upper: SVector::repeat(cells as f64 * self.h()),
-            cells,
-        }
+        Domain::padded(self.length, self.cells, self.extra_cells)
     }
 
     fn body(&self) -> (SVector<f64, 1>, SVector<f64, 1>) {
@@ -234,10 +219,7 @@ impl Problem<1> for DykaBar {
 
     /// nu = 0, so lambda = 0, 2 mu = E and sigma_t = E v_x.
     fn material(&self) -> Material {
-        Material::LinearElasticRate(LinearElasticRate {
-            lambda: 0.0,
-            mu: 0.5 * self.young,
-        })
+        Material::LinearElasticRate(LinearElasticRate::without_poisson(self.young))
     }
 
     fn dt(&self) -> f64 {
@@ -302,6 +284,10 @@ impl Problem<1> for DykaBar {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn cell(bar: &DykaBar) -> f64 {
+        bar.length / bar.cells as f64
+    }
     use crate::benchmarks::{catalog, default_params};
     use crate::params::ParamValue;
 
@@ -321,17 +307,17 @@ mod tests {
     fn is_in_the_catalogue_with_the_papers_grid_and_steps() {
         assert!(catalog().iter().any(|b| b.name == "dyka_bar"));
         let bar = bar(&[]);
-        assert!((bar.h() - 3.3325e-3).abs() < 1e-15);
+        assert!((cell(&bar) - 3.3325e-3).abs() < 1e-15);
         // c = sqrt(200e9 / 7833) = 5053.02 m/s, so dt = 0.5 h / c = 3.2975e-7 s and
         // t_end / dt = 606.52: 607 steps of t_end / 607.
         let c = bar.wave_speed();
         assert!((c - 5053.02).abs() < 0.01, "{c}");
         assert_eq!(bar.steps(), 607);
         assert!((bar.dt() * 607.0 - 2e-4).abs() < 1e-18);
-        assert!(bar.dt() <= 0.5 * bar.h() / c);
+        assert!(bar.dt() <= 0.5 * cell(&bar) / c);
         let domain = bar.domain();
         assert_eq!(domain.cells, 41);
-        assert!((domain.upper[0] - 41.0 * bar.h()).abs() < 1e-15);
+        assert!((domain.upper[0] - 41.0 * cell(&bar)).abs() < 1e-15);
     }
 
     /// rho0 v_t = sigma_x and sigma_t = E v_x by central differences, at points and times
@@ -474,7 +460,7 @@ mod tests {
     #[test]
     fn probes_are_the_free_end_velocity_and_the_mid_stress() {
         let bar = bar(&[]);
-        let h = bar.h();
+        let h = cell(&bar);
         let x0: Vec<SVector<f64, 1>> = (0..40)
             .map(|i| SVector::repeat((i as f64 + 0.5) * h))
             .collect();

@@ -228,6 +228,31 @@ pub struct Domain<const D: usize> {
     pub cells: usize,
 }
 
+impl<const D: usize> Domain<D> {
+    /// The box [0, (cells + extra) h]^D with h = length / cells: a body of side `length` from
+    /// the origin, with `extra` empty cells beyond its upper faces for it to move into.
+    pub fn padded(length: f64, cells: usize, extra: usize) -> Self {
+        let total = cells + extra;
+        Domain {
+            lower: SVector::zeros(),
+            upper: SVector::repeat(total as f64 * (length / cells as f64)),
+            cells: total,
+        }
+    }
+}
+
+/// The `cfl` parameter of an explicit benchmark, refused above 1.
+fn courant_number(params: &Params) -> Result<f64, ParamError> {
+    let cfl = crate::params::get_f64(params, "cfl")?;
+    if cfl > 1.0 {
+        return Err(ParamError::new(
+            "cfl",
+            format!("cfl = {cfl} > 1 makes the explicit scheme unstable; use cfl <= 1"),
+        ));
+    }
+    Ok(cfl)
+}
+
 /// Which velocity components are held at zero on the faces of the domain box
 /// (`[axis][0]` the lower face, `[axis][1]` the upper face, the component normal to it).
 pub type FixedFaces<const D: usize> = [[bool; 2]; D];
