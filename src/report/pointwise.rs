@@ -1,8 +1,8 @@
 //! The tables that experiments ask for: u - u^h at the nodes in Gong's format (Tables
 //! 4.1-4.2), the <p_i, p_i> of the orthogonal basis (Tran Figs 1-3), the errors of the
 //! element-wise fits (Wobbes sec 2.1), measured stability limits (`stability`), and every
-//! run's final error in one field and norm. They go
-//! into report.md; the numbers come from the run files unchanged.
+//! run's final error in one field and norm. They go into report.md; the numbers come from the
+//! run files unchanged.
 
 use super::format::general;
 use super::group::{axis_values, group_runs, label, ordered_runs, selects, title_suffix};
