@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::experiment::FigureKind;
 use crate::experiment::{self, Experiment};
-use crate::output::{read_profile, read_summary, run_path, RunSummary};
+use crate::output::{read_probes, read_profile, read_summary, run_path, RunSummary};
 use crate::runner::EXPERIMENT_COPY;
 
 pub struct Collected {
@@ -36,6 +36,9 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
             if wants_profiles(&experiment) {
                 run.profile = read_profile(&path)?;
             }
+            if draws_histories(&experiment) {
+                run.probes = read_probes(&path)?;
+            }
             runs.push(run);
         } else {
             missing.push(spec.run_id.clone());
@@ -58,4 +61,12 @@ fn wants_profiles(experiment: &Experiment) -> bool {
             .figures
             .iter()
             .any(|f| f.kind == FigureKind::Profile)
+}
+
+/// Whether the report draws probe histories, which need the `/probes` of every run.
+fn draws_histories(experiment: &Experiment) -> bool {
+    experiment
+        .figures
+        .iter()
+        .any(|f| f.kind == FigureKind::History)
 }

@@ -125,6 +125,13 @@ pub struct Method {
     pub integrator: IntegratorKind,
 }
 
+impl Method {
+    /// Whether the basis takes the particles' domains from the seed lattice's sub-cells.
+    pub fn reads_seed_domains(&self) -> bool {
+        matches!(self.shape, ShapeKind::Domain(_))
+    }
+}
+
 pub struct MethodPreset {
     pub name: &'static str,
     pub method: Method,

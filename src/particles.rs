@@ -3,6 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::benchmarks::Problem;
+use crate::reconstruct::gauss_legendre_rule;
 use crate::shape::{lattice_coords, Grid};
 
 /// State carried by the material points. Velocities are the leapfrog half-step values
@@ -41,9 +42,21 @@ impl<const D: usize> SeedLattice<D> {
     }
 }
 
+/// Where the points sit inside each grid cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// The centres of a regular sub-grid of `ppc` sub-cells per axis, each with the sub-cell's
+    /// volume (Gong sec 4.6). The particle-domain methods read these sub-cells as domains.
+    SubCellCentres,
+    /// The `ppc`-point Gauss-Legendre abscissae of the cell per axis, each with its Gauss
+    /// weight's share of the cell (Molinos et al. sec 6.2: the points of a quadratic finite
+    /// element for ppc = 2, x_e + h (1 -+ 1/sqrt 3) / 2, equal volumes).
+    Gauss,
+}
+
 impl<const D: usize> Particles<D> {
-    /// `ppc^D` points per grid cell of the problem's body, at the centres of a regular
-    /// sub-grid (Gong sec 4.6: x_e + (j - 1/2) h / ppc), numbered with the first axis fastest.
+    /// `ppc^D` points per grid cell of the problem's body, where the problem's placement puts
+    /// them, numbered with the first axis fastest.
     pub fn seed(problem: &dyn Problem<D>, grid: &Grid<D>) -> Self {
         let (lo, hi) = problem.body();
         let ppc = problem.ppc();
@@ -51,18 +64,39 @@ impl<const D: usize> Particles<D> {
         let per_axis: [usize; D] =
             std::array::from_fn(|k| ((hi[k] - lo[k]) / grid.h).round() as usize * ppc);
         let count: usize = per_axis.iter().product();
-        let volume = spacing.powi(D as i32);
         let lattice = SeedLattice {
             lower: lo,
             spacing,
             per_axis,
         };
-        let x0: Vec<SVector<f64, D>> = (0..count)
-            .map(|p| {
-                let m = lattice.cell_of(p);
-                SVector::from_fn(|k, _| lo[k] + (m[k] as f64 + 0.5) * spacing)
-            })
-            .collect();
+        let (x0, volume): (Vec<SVector<f64, D>>, Vec<f64>) = match problem.placement() {
+            Placement::SubCellCentres => {
+                let volume = spacing.powi(D as i32);
+                (0..count)
+                    .map(|p| {
+                        let m = lattice.cell_of(p);
+                        let x = SVector::from_fn(|k, _| lo[k] + (m[k] as f64 + 0.5) * spacing);
+                        (x, volume)
+                    })
+                    .unzip()
+            }
+            Placement::Gauss => {
+                let (nodes, weights) = gauss_legendre_rule(ppc);
+                let half = 0.5 * grid.h;
+                (0..count)
+                    .map(|p| {
+                        // Sub-cell m of the lattice is Gauss point m % ppc of cell m / ppc.
+                        let m = lattice.cell_of(p);
+                        let x = SVector::from_fn(|k, _| {
+                            let cell = lo[k] + (m[k] / ppc) as f64 * grid.h;
+                            cell + half * (1.0 + nodes[m[k] % ppc])
+                        });
+                        let volume: f64 = m.iter().map(|&mk| half * weights[mk % ppc]).product();
+                        (x, volume)
+                    })
+                    .unzip()
+            }
+        };
         let v = x0.iter().map(|x| problem.initial_velocity(x)).collect();
         Particles {
             x: x0.clone(),
@@ -70,9 +104,9 @@ impl<const D: usize> Particles<D> {
             f: vec![SMatrix::identity(); count],
             j: vec![1.0; count],
             stress: vec![SMatrix::zeros(); count],
-            mass: vec![problem.rho0() * volume; count],
-            volume0: vec![volume; count],
-            volume: vec![volume; count],
+            mass: volume.iter().map(|v| problem.rho0() * v).collect(),
+            volume0: volume.clone(),
+            volume,
             lattice,
             x0,
         }

@@ -966,7 +966,7 @@ fn figures_and_tables_must_suit_the_benchmark() {
         10,
         28,
         "figures[0].by",
-        "applies to convergence and shape_functions figures only",
+        "applies to convergence, shape_functions and history figures only",
         &[],
     );
     let e = error(&edited_in(
@@ -1257,5 +1257,78 @@ fn integrator_must_be_known_and_fit_the_transfer() {
     assert!(
         e.message.contains("Shepard transfer: mpm, mpm_musl,"),
         "{e}"
+    );
+}
+
+const MOLINOS: &str = "\
+name: molinos
+benchmark: andersen_block
+params: {t_end: 1.0}
+matrix:
+  - {method: [mpm], placement: [gauss]}
+  - {method: [ugimp], placement: [centres]}
+figures:
+  - {kind: history, probe: top_displacement, by: method}
+tables:
+  - {kind: errors, field: velocity, norm: rms}
+";
+
+#[test]
+fn history_figures_and_errors_tables_are_read() {
+    let exp = parse(MOLINOS).unwrap();
+    assert_eq!(exp.figures[0].kind, FigureKind::History);
+    assert_eq!(exp.figures[0].probe.as_deref(), Some("top_displacement"));
+    assert_eq!(
+        exp.tables[0].measure,
+        Some(("velocity".to_string(), "rms".to_string()))
+    );
+    assert_eq!(exp.runs.len(), 2);
+}
+
+#[test]
+fn a_history_figure_needs_a_probe() {
+    let text = MOLINOS.replace("probe: top_displacement, ", "");
+    check(
+        &error(&text),
+        8,
+        5,
+        "figures[0].probe",
+        "needs 'probe'",
+        &[],
+    );
+}
+
+#[test]
+fn an_errors_table_needs_a_known_field() {
+    let text = MOLINOS.replace("field: velocity, ", "");
+    check(
+        &error(&text),
+        10,
+        5,
+        "tables[0].field",
+        "needs 'field'",
+        &["velocity", "stress"],
+    );
+    let text = MOLINOS.replace("field: velocity", "field: speed");
+    check(
+        &error(&text),
+        10,
+        27,
+        "tables[0].field",
+        "speed",
+        &["velocity"],
+    );
+}
+
+#[test]
+fn gauss_placement_is_refused_with_particle_domains() {
+    let text = MOLINOS.replace("placement: [centres]", "placement: [gauss]");
+    check(
+        &error(&text),
+        6,
+        35,
+        "matrix[1].placement[0]",
+        "ugimp takes the seed lattice's sub-cells as particle domains",
+        &[],
     );
 }

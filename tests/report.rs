@@ -6,7 +6,7 @@ use std::path::Path;
 
 use mpmlab::benchmarks::BenchmarkKind;
 use mpmlab::experiment::{Expectation, Experiment, FigureKind, FigureSpec, OutputSpec};
-use mpmlab::output::{RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use mpmlab::output::{ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
 use mpmlab::report::{check, fit_rates, write_report, CheckFailure};
 
@@ -63,6 +63,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         shape_functions: None,
         velocity_history: None,
         profile: None,
+        probes: Vec::new(),
     }
 }
 
@@ -335,6 +336,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         by: Some("G".into()),
         select: Params::new(),
         stability: None,
+        probe: None,
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let dir = tempfile::tempdir().unwrap();
@@ -395,4 +397,60 @@ fn figures_no_longer_drawn_are_removed() {
     assert!(!stale.exists());
     assert!(!report.figures.is_empty());
     assert!(report.figures.iter().all(|f| dir.path().join(f).exists()));
+}
+
+/// A run of `method` with a probe `tip` over 11 steps (value t, exact reference 2t); a diverged
+/// run stops after 6.
+fn probed(method: &str, status: RunStatus) -> RunSummary {
+    let mut run = run("0.1", method, 8);
+    let steps = if status == RunStatus::Ok { 11 } else { 6 };
+    let time: Vec<f64> = (0..steps).map(|s| s as f64 * 0.1).collect();
+    run.status = status;
+    run.probes = vec![ProbeRecord {
+        name: "tip".into(),
+        particle: 3,
+        x0: vec![0.5, 1.0],
+        quantity: "velocity".into(),
+        component: vec![1],
+        reference_kind: "exact".into(),
+        value: time.clone(),
+        reference: time.iter().map(|t| 2.0 * t).collect(),
+        step: (0..steps as i64).collect(),
+        time,
+    }];
+    run
+}
+
+fn history(probe: &str) -> FigureSpec {
+    FigureSpec {
+        kind: FigureKind::History,
+        fields: Vec::new(),
+        norm: "l2".into(),
+        by: Some("method".into()),
+        select: Params::new(),
+        stability: None,
+        probe: Some(probe.into()),
+    }
+}
+
+#[test]
+fn history_figures_draw_every_run_and_name_unknown_probes() {
+    let runs = vec![
+        probed("mpm", RunStatus::Ok),
+        probed("usl", RunStatus::Diverged),
+    ];
+    let exp = experiment(vec![], vec![history("tip")]);
+    let dir = tempfile::tempdir().unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    assert_eq!(
+        report.figures,
+        [Path::new("figures/gong_conv_tip_G_0.1_cells_8.png")]
+    );
+    assert!(dir.path().join(&report.figures[0]).exists());
+
+    let exp = experiment(vec![], vec![history("root")]);
+    let error = write_report(dir.path(), &exp, &runs, &[], None).unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("probe 'root'"), "{message}");
+    assert!(message.contains("the runs record: tip"), "{message}");
 }

@@ -3,6 +3,8 @@
 //! benchmarks (`scattered`) have no time stepping: a known function sampled at points; nor has
 //! `shape_functions`, a grid basis evaluated at points.
 
+mod andersen_block;
+mod dyka_bar;
 mod mms_gong;
 mod mms_tran;
 pub mod scattered;
@@ -14,6 +16,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::material::Material;
 use crate::params::{ParamError, ParamValue, Params};
+use crate::particles::Placement;
 
 pub use mms_gong::{gong_mms, thesis_params};
 pub use sine_mms::SineMms;
@@ -84,6 +87,8 @@ const CATALOG: &[BenchmarkInfo] = &[
     mms_gong::INFO_2D,
     mms_tran::INFO,
     vibrating_bar::INFO,
+    dyka_bar::INFO,
+    andersen_block::INFO,
     scattered::INFO_NODES,
     scattered::INFO_BASIS,
     scattered::INFO_ELEMENTS,
@@ -165,12 +170,107 @@ pub struct ExactState<const D: usize> {
     pub density: f64,
 }
 
+/// What a probe records at its particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProbeQuantity {
+    Displacement(usize),
+    Velocity(usize),
+    Stress(usize, usize),
+}
+
+impl ProbeQuantity {
+    /// The quantity's name in the run file (`/probes/<name>` attribute `quantity`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ProbeQuantity::Displacement(_) => "displacement",
+            ProbeQuantity::Velocity(_) => "velocity",
+            ProbeQuantity::Stress(..) => "stress",
+        }
+    }
+
+    /// The component: one index for a vector, row and column for the stress.
+    pub fn component(self) -> Vec<usize> {
+        match self {
+            ProbeQuantity::Displacement(k) | ProbeQuantity::Velocity(k) => vec![k],
+            ProbeQuantity::Stress(i, j) => vec![i, j],
+        }
+    }
+
+    /// The quantity's value in a state: displacement, velocity and Cauchy stress.
+    pub fn of<const D: usize>(
+        self,
+        displacement: &SVector<f64, D>,
+        velocity: &SVector<f64, D>,
+        stress: &SMatrix<f64, D, D>,
+    ) -> f64 {
+        match self {
+            ProbeQuantity::Displacement(k) => displacement[k],
+            ProbeQuantity::Velocity(k) => velocity[k],
+            ProbeQuantity::Stress(i, j) => stress[(i, j)],
+        }
+    }
+}
+
+/// A quantity recorded at one particle every step (Molinos et al. Figs 5-13): the particle whose
+/// reference position is nearest `at` (ties: the lowest index).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe<const D: usize> {
+    pub name: &'static str,
+    pub at: SVector<f64, D>,
+    pub quantity: ProbeQuantity,
+}
+
+/// Squared distances closer than this (relative) are a tie: equidistant particles differ by
+/// rounding only.
+const TIE_TOLERANCE: f64 = 1e-9;
+
+impl<const D: usize> Probe<D> {
+    /// The index of the particle nearest `at` among the reference positions `x0`; `None` when
+    /// there are none.
+    pub fn nearest(&self, x0: &[SVector<f64, D>]) -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for (p, x) in x0.iter().enumerate() {
+            let d = (x - self.at).norm_squared();
+            // Nearer by more than rounding only, so a tie keeps the lower index.
+            if best.is_none_or(|(_, b)| d < b * (1.0 - TIE_TOLERANCE)) {
+                best = Some((p, d));
+            }
+        }
+        best.map(|(p, _)| p)
+    }
+}
+
 /// A uniform background grid over a box, `cells` cells per direction.
 #[derive(Clone, Copy, Debug)]
 pub struct Domain<const D: usize> {
     pub lower: SVector<f64, D>,
     pub upper: SVector<f64, D>,
     pub cells: usize,
+}
+
+impl<const D: usize> Domain<D> {
+    /// The box [0, (cells + extra) h]^D with h = length / cells: a body of side `length` from
+    /// the origin, with `extra` empty cells beyond its upper faces for it to move into.
+    pub fn padded(length: f64, cells: usize, extra: usize) -> Self {
+        let total = cells + extra;
+        Domain {
+            lower: SVector::zeros(),
+            upper: SVector::repeat(total as f64 * (length / cells as f64)),
+            cells: total,
+        }
+    }
+}
+
+/// The `cfl` parameter of an explicit benchmark, refused above 1.
+fn courant_number(params: &Params) -> Result<f64, ParamError> {
+    let cfl = crate::params::get_f64(params, "cfl")?;
+    if cfl > 1.0 {
+        return Err(ParamError::new(
+            "cfl",
+            format!("cfl = {cfl} > 1 makes the explicit scheme unstable; use cfl <= 1"),
+        ));
+    }
+    Ok(cfl)
 }
 
 /// Which velocity components are held at zero on the faces of the domain box
@@ -195,6 +295,18 @@ pub trait Problem<const D: usize>: Send + Sync {
     /// Prepare `body_force` for these reference positions (called once before stepping).
     fn attach_particles(&mut self, x0: &[SVector<f64, D>]);
     fn exact(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>>;
+    /// Where the particles are seeded inside each cell.
+    fn placement(&self) -> Placement {
+        Placement::SubCellCentres
+    }
+    fn probes(&self) -> Vec<Probe<D>> {
+        Vec::new()
+    }
+    /// The solution a probe is drawn against: the exact one where there is one; a benchmark without one
+    /// may give another reference (the quasi-static solution of the Andersen block).
+    fn probe_reference(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>> {
+        self.exact(x0, t)
+    }
 }
 
 /// A problem of either supported dimension.
@@ -210,6 +322,10 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
         "mms2d_gong" => Ok(AnyProblem::D2(Box::new(gong_mms::<2>(params)?))),
         "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
         "vibrating_bar" => Ok(AnyProblem::D1(Box::new(vibrating_bar(params)?))),
+        "dyka_bar" => Ok(AnyProblem::D1(Box::new(dyka_bar::dyka_bar(params)?))),
+        "andersen_block" => Ok(AnyProblem::D2(Box::new(andersen_block::andersen_block(
+            params,
+        )?))),
         other => Err(ParamError::new(
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),

@@ -188,10 +188,7 @@ impl Problem<1> for VibratingBar {
 
     /// nu = 0, so lambda = 0, 2 mu = E and sigma_t = E v_x.
     fn material(&self) -> Material {
-        Material::LinearElasticRate(LinearElasticRate {
-            lambda: 0.0,
-            mu: 0.5 * self.young,
-        })
+        Material::LinearElasticRate(LinearElasticRate::without_poisson(self.young))
     }
 
     fn dt(&self) -> f64 {

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use crate::benchmarks;
 use crate::methods;
-use crate::params::{ParamError, Params};
+use crate::params::{ParamError, ParamValue, Params};
 use crate::reference;
 
 use super::document::Benchmark;
@@ -16,6 +16,10 @@ use super::space::{Block, ParamSpace, Written};
 use super::values::{method_names, METHOD_KEY};
 use super::yaml::child_field;
 use super::RunSpec;
+
+/// The seeding parameter of benchmarks that offer a choice of particle placement.
+const PLACEMENT_KEY: &str = "placement";
+const GAUSS_PLACEMENT: &str = "gauss";
 
 /// More runs than this is taken to be a mistake in the matrix, not a plan.
 pub const MAX_RUNS: usize = 100_000;
@@ -154,6 +158,9 @@ fn resolve(
             .filter(|m| reference::unsupported(m, benchmark.info.name).is_none());
         return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
     }
+    if let Some(error) = placement_conflict(&method, &params) {
+        return Err(check_error(error, benchmark, &params, chosen));
+    }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
     if benchmarks::kind(benchmark.info).steps() {
         check_method_params(&method, benchmark, &params)
@@ -195,6 +202,22 @@ fn check_method_params(
         )),
         _ => Ok(()),
     }
+}
+
+/// The particle-domain methods (GIMP, CPDI) take the sub-cells of the seed lattice as the
+/// particles' domains, which only sub-cell centres sit in the middle of.
+fn placement_conflict(method: &str, params: &Params) -> Option<ParamError> {
+    let gauss = params.get(PLACEMENT_KEY) == Some(&ParamValue::Str(GAUSS_PLACEMENT.into()));
+    let domains = methods::preset(method).is_some_and(|p| p.method.reads_seed_domains());
+    (gauss && domains).then(|| {
+        ParamError::new(
+            PLACEMENT_KEY,
+            format!(
+                "{method} takes the seed lattice's sub-cells as particle domains, which the \
+                 Gauss points do not sit at the centres of; use placement: centres"
+            ),
+        )
+    })
 }
 
 /// Places a failed benchmark check at the value it names: the matrix element or params entry

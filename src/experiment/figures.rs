@@ -25,8 +25,9 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("growth", FigureKind::Growth),
         ("profile", FigureKind::Profile),
         ("shape_functions", FigureKind::ShapeFunctions),
+        ("history", FigureKind::History),
     ],
-    keys: &["kind", "fields", "norm", "by", "x", "sweep"],
+    keys: &["kind", "fields", "norm", "by", "x", "sweep", "probe"],
     takes,
     suits: draws_for,
 };
@@ -71,6 +72,17 @@ fn figure(
         Some(e) => Some(axis_key(e.value, &child_field(parent, "by"), space)?),
         None => None,
     };
+    let probe = match (find(&entries, "probe"), kind) {
+        (Some(e), _) => Some(e.value.as_text(&child_field(parent, "probe"))?.to_string()),
+        (None, FigureKind::History) => {
+            return Err(ConfigError::at(
+                node.pos,
+                child_field(parent, "probe"),
+                "a history figure needs 'probe': the name of a probe its runs record",
+            ))
+        }
+        (None, _) => None,
+    };
     Ok(FigureSpec {
         kind: kind.clone(),
         fields,
@@ -78,6 +90,7 @@ fn figure(
         by,
         select,
         stability,
+        probe,
     })
 }
 
@@ -90,6 +103,7 @@ fn takes(kind: &FigureKind) -> &'static [&'static str] {
         FigureKind::Growth => &["sweep"],
         FigureKind::Profile => &["fields"],
         FigureKind::ShapeFunctions => &["by"],
+        FigureKind::History => &["probe", "by"],
     }
 }
 
@@ -101,7 +115,7 @@ fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
         FigureKind::ShapeFunctions => benchmark == BenchmarkKind::ShapeFunctions,
         FigureKind::Reconstruction => benchmark.is_reconstruction(),
         FigureKind::Basis => benchmark == BenchmarkKind::OrthogonalBasis,
-        FigureKind::Stability | FigureKind::Growth | FigureKind::Profile => {
+        FigureKind::Stability | FigureKind::Growth | FigureKind::Profile | FigureKind::History => {
             benchmark == BenchmarkKind::Simulation
         }
     }

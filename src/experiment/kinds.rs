@@ -81,7 +81,7 @@ impl<K> Kinds<K> {
             format!(
                 "'{}' applies to {} {}s only",
                 e.key,
-                takers.join(" and "),
+                enumeration(&takers),
                 self.what
             ),
         ))
@@ -116,5 +116,13 @@ impl<K> Kinds<K> {
             ),
         )
         .with_valid(suitable.map(|(name, _)| name)))
+    }
+}
+
+/// "a", "a and b", "a, b and c".
+fn enumeration(items: &[&str]) -> String {
+    match items.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => items.join(""),
     }
 }

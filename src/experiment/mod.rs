@@ -58,7 +58,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let measures = Measures::of(kind).with_reference(reference.is_some());
     let expect = expect::read(sections.get("expect"), &space, measures)?;
     let figures = figures::read(sections.get("figures"), &space, kind, measures)?;
-    let tables = tables::read(sections.get("tables"), &space, kind)?;
+    let tables = tables::read(sections.get("tables"), &space, kind, measures)?;
     let runs = expand::expand(&name, &benchmark, &space, output.every)?;
     if let (Some(select), Some(section)) = (&reference, sections.get("reference")) {
         reference::check_unique(select, &runs, section)?;
@@ -195,6 +195,9 @@ pub enum FigureKind {
     /// dN_a/dx along the line through it parallel to x, one curve per run, the hat in grey
     /// (Molinos et al. Fig 3).
     ShapeFunctions,
+    /// A probe's value over time, one line per run (per value of `by` in one figure), with
+    /// the benchmark's reference for it in grey (Molinos Figs 5-13).
+    History,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -208,6 +211,8 @@ pub struct FigureSpec {
     pub select: Params,
     /// Stability and growth figures only.
     pub stability: Option<StabilityAxes>,
+    /// History figures only: the probe drawn (checked against the run files by the report).
+    pub probe: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -222,6 +227,9 @@ pub enum TableKind {
     /// One row per element-wise run: RMS and integral errors, and the elements whose fit
     /// dropped a degree (Wobbes sec 2.1).
     ElementFits,
+    /// One row per run: its axis values and its final error in one field and norm (Molinos
+    /// eq 40 with velocity and rms).
+    Errors,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -233,4 +241,6 @@ pub struct TableSpec {
     pub select: Params,
     /// Stability tables only.
     pub stability: Option<StabilityAxes>,
+    /// Errors tables only: the (field, norm) listed.
+    pub measure: Option<(String, String)>,
 }

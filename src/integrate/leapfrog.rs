@@ -59,7 +59,18 @@ pub fn synchronized_velocity<const D: usize>(
     out: &mut [SVector<f64, D>],
 ) {
     for (p, out) in out.iter_mut().enumerate() {
-        let a: SVector<f64, D> = stencils.of(p).map(|(i, w, _)| grid.force[i] * w).sum();
-        *out = particles.v[p] + a * half;
+        *out = synchronized_velocity_of(stencils, particles, grid, half, p);
     }
+}
+
+/// `synchronized_velocity` of particle `p` alone.
+pub fn synchronized_velocity_of<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    grid: &GridState<D>,
+    half: f64,
+    p: usize,
+) -> SVector<f64, D> {
+    let a: SVector<f64, D> = stencils.of(p).map(|(i, w, _)| grid.force[i] * w).sum();
+    particles.v[p] + a * half
 }

@@ -10,6 +10,15 @@ pub struct LinearElasticRate {
 }
 
 impl LinearElasticRate {
+    /// Young's modulus `young` with nu = 0: lambda = 0 and 2 mu = E, so each normal stress
+    /// follows its own strain rate, sigma_t = E v_x in 1D.
+    pub fn without_poisson(young: f64) -> Self {
+        LinearElasticRate {
+            lambda: 0.0,
+            mu: 0.5 * young,
+        }
+    }
+
     /// The stress after a step of length `dt` with velocity gradient `grad_v`.
     #[inline]
     pub fn advance<const D: usize>(

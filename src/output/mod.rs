@@ -135,6 +135,9 @@ pub struct RunSummary {
     /// The state at the last sample of a 1D simulation run, when the report compares runs
     /// with a reference run or draws fields along the bar (`collect` fills it).
     pub profile: Option<Profile>,
+    /// The `/probes` of a simulation run, when the report draws their histories (`collect`
+    /// fills it); empty otherwise.
+    pub probes: Vec<ProbeRecord>,
 }
 
 /// The last sample of a 1D simulation run, one value per particle (per element for a
@@ -178,6 +181,7 @@ pub struct VelocityHistory {
 
 mod atomic;
 mod elements;
+mod probes;
 mod reader;
 mod reconstruction;
 mod record;
@@ -186,7 +190,8 @@ mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
 pub use elements::ElementRecord;
-pub use reader::{read_profile, read_summary};
+pub use probes::{ProbeRecord, REFERENCE_KINDS};
+pub use reader::{read_probes, read_profile, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,

@@ -6,8 +6,8 @@ use hdf5::Location;
 use ndarray::s;
 
 use super::{
-    elements, reconstruction, shape_functions, Profile, RunStatus, RunSummary, VelocityHistory,
-    ERROR_FIELDS, NORMS,
+    elements, probes, reconstruction, shape_functions, ProbeRecord, Profile, RunStatus, RunSummary,
+    VelocityHistory, ERROR_FIELDS, NORMS,
 };
 use super::{
     ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS, SHAPE_FIELDS, SHAPE_NORMS,
@@ -70,7 +70,15 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         shape_functions,
         velocity_history,
         profile: None,
+        probes: Vec::new(),
     })
+}
+
+/// The `/probes` of a run file (none for a run without them).
+pub fn read_probes(path: &Path) -> Result<Vec<ProbeRecord>, String> {
+    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
+    let file = hdf5::File::open(path).map_err(context)?;
+    probes::read(&file).map_err(context)
 }
 
 /// The last sample of a 1D simulation run; `None` for a run without samples.

@@ -1,4 +1,4 @@
-use super::{ElementRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord};
+use super::{ElementRecord, ProbeRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
@@ -24,6 +24,8 @@ pub struct RunRecord {
     pub errors: Errors,
     pub conservation: Conservation,
     pub diagnostics: Diagnostics,
+    /// `/probes`: every-step records at single particles (none for reference solvers).
+    pub probes: Vec<ProbeRecord>,
     /// Set for the runs of reconstruction benchmarks, which have no particles or history.
     pub reconstruction: Option<ReconstructionRecord>,
     /// Set instead for the runs of the element-wise reconstruction benchmark.

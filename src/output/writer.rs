@@ -4,7 +4,9 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
-use super::{elements, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, SCHEMA_VERSION};
+use super::{
+    elements, probes, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, SCHEMA_VERSION,
+};
 use crate::params::ParamValue;
 
 /// Writes the whole record into a new HDF5 file at `path` (which must not exist).
@@ -89,6 +91,7 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     ] {
         attr_i64(&diagnostics, name, value as i64)?;
     }
+    probes::write(&file, &r.probes)?;
     file.flush()?;
     Ok(())
 }

@@ -61,7 +61,7 @@ pub fn write_report(
     rates: &[RateRow],
     check: Option<&[CheckFailure]>,
 ) -> io::Result<Report> {
-    let figures = figures::plan(experiment, runs);
+    let figures = figures::plan(experiment, runs).map_err(io::Error::other)?;
     let figure_dir = dir.join("figures");
     fs::create_dir_all(&figure_dir)?;
     remove_stale_figures(&figure_dir, &figures)?;

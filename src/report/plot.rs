@@ -172,6 +172,9 @@ where
             Marker::Square => {
                 chart.draw_series(points.map(|p| EmptyElement::at(p) + square((0, 0), style)))?;
             }
+            Marker::Cross => {
+                chart.draw_series(points.map(|p| Cross::new(p, 2 * MARKER_SIZE, style)))?;
+            }
         }
     }
     Ok(())
@@ -218,6 +221,7 @@ fn draw_glyph(area: &Area, series: &Series, (x, y): (i32, i32), style: ShapeStyl
         (true, _) => area.draw(&segment(7, 17))?,
         (false, Marker::Circle) => area.draw(&Circle::new((x + 12, y), MARKER_SIZE, style))?,
         (false, Marker::Square) => area.draw(&square((x + 12, y), style))?,
+        (false, Marker::Cross) => area.draw(&Cross::new((x + 12, y), 2 * MARKER_SIZE, style))?,
     }
     Ok(())
 }

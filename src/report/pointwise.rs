@@ -1,13 +1,14 @@
 //! The tables that experiments ask for: u - u^h at the nodes in Gong's format (Tables
 //! 4.1-4.2), the <p_i, p_i> of the orthogonal basis (Tran Figs 1-3), the errors of the
-//! element-wise fits (Wobbes sec 2.1), and measured stability limits (`stability`). They go
-//! into report.md; the numbers come from the run files unchanged.
+//! element-wise fits (Wobbes sec 2.1), measured stability limits (`stability`), and every
+//! run's final error in one field and norm. They go into report.md; the numbers come from the
+//! run files unchanged.
 
 use super::format::general;
-use super::group::{group_runs, label, selects, title_suffix};
+use super::group::{axis_values, group_runs, label, ordered_runs, selects, title_suffix};
 use super::stability;
 use crate::experiment::{Experiment, TableKind, TableSpec};
-use crate::output::{ElementRecord, ReconstructionRecord, RunSummary};
+use crate::output::{ElementRecord, ReconstructionRecord, RunStatus, RunSummary};
 
 /// A table with a heading and a note on how to read it.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,6 +29,7 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
             TableKind::BasisNorms => tables.extend(basis_norms(selected)),
             TableKind::Stability => tables.extend(stability::tables(selected, spec)),
             TableKind::ElementFits => tables.extend(element_fits(experiment, selected)),
+            TableKind::Errors => tables.extend(final_errors(experiment, selected, spec)),
         }
     }
     tables
@@ -175,6 +177,50 @@ fn element_fits<'a>(
                An element below the degree had data that could not support every Taylor \
                function of it, and its fit dropped the whole degree."
             .into(),
+        header,
+        rows,
+    })
+}
+
+/// One row per run in the order of the run tables: its axis values, status and final error in
+/// the spec's field and norm (empty for a run that stopped before its final time).
+fn final_errors<'a>(
+    experiment: &Experiment,
+    runs: impl Iterator<Item = &'a RunSummary>,
+    spec: &TableSpec,
+) -> Option<Table> {
+    let (field, norm) = spec.measure.as_ref()?;
+    let runs: Vec<RunSummary> = runs.cloned().collect();
+    if runs.is_empty() {
+        return None;
+    }
+    let mut header = experiment.axes.clone();
+    header.extend(["status".to_string(), format!("{norm} {field} error")]);
+    let rows = ordered_runs(&runs)
+        .into_iter()
+        .map(|run| {
+            let mut row: Vec<String> = axis_values(experiment, run).collect();
+            let error = run.final_norms.get(&(field.clone(), norm.clone()));
+            let finished = run.status == RunStatus::Ok;
+            row.push(run.status.as_str().to_string());
+            row.push(
+                error
+                    .filter(|_| finished)
+                    .map_or_else(String::new, |&e| general(e, 4)),
+            );
+            row
+        })
+        .collect();
+    Some(Table {
+        title: format!(
+            "Final {norm} {field} error{}",
+            title_suffix(&label(&spec.select))
+        ),
+        note: format!(
+            "The {norm} norm of the {field} error over the particles at the final time (rms: \
+             sqrt(sum_p e_p^2 / N_p), Molinos eq 40; l2: sqrt(sum_p V_p e_p^2)); NaN where the \
+             benchmark has no exact solution, empty for a run that did not finish."
+        ),
         header,
         rows,
     })

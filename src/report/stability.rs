@@ -288,6 +288,7 @@ mod tests {
                 initial_l2: 2.0,
             }),
             profile: None,
+            probes: Vec::new(),
         }
     }
 

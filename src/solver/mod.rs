@@ -144,6 +144,8 @@ impl<'a, const D: usize> Run<'a, D> {
         let particles = Particles::seed(problem.as_ref(), &grid);
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
+        let mut recorder = Recorder::new();
+        recorder.attach_probes(problem.as_ref(), &particles.x0);
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
         let (basis, per_point) = match method.shape {
@@ -187,7 +189,7 @@ impl<'a, const D: usize> Run<'a, D> {
             fits: FitStats::default(),
             cells: Vec::new(),
             grid_crossings: 0,
-            recorder: Recorder::new(),
+            recorder,
             problem,
         }
     }
@@ -254,9 +256,10 @@ impl<'a, const D: usize> Run<'a, D> {
             if let Some(carried) = &mut self.carried {
                 carried.keep(&self.nodes);
             }
+            self.record_probes(s, t, synchronising_half(s, dt));
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
                 let velocity = if staggered {
-                    let half = if s == 0 { 0.0 } else { 0.5 * dt };
+                    let half = synchronising_half(s, dt);
                     leapfrog::synchronized_velocity(
                         &self.stencils,
                         &self.particles,
@@ -291,6 +294,22 @@ impl<'a, const D: usize> Run<'a, D> {
             }
         }
         (steps, Ok(()))
+    }
+
+    /// The probes' values at step `s`, time `t`; `half` as in `synchronising_half`. Leapfrog
+    /// synchronises the velocity of the probed particles only.
+    fn record_probes(&mut self, s: usize, t: f64, half: f64) {
+        let staggered = self.method.integrator.staggers_velocity();
+        let (stencils, particles, nodes) = (&self.stencils, &self.particles, &self.nodes);
+        let velocity = |p: usize| {
+            if staggered {
+                leapfrog::synchronized_velocity_of(stencils, particles, nodes, half, p)
+            } else {
+                particles.v[p]
+            }
+        };
+        self.recorder
+            .record_probes(s, t, particles, velocity, self.problem.as_ref());
     }
 
     /// The cell of every particle; after the first call, counts the particles that changed
@@ -401,6 +420,16 @@ impl<'a, const D: usize> Run<'a, D> {
     }
 }
 
+/// What a staggered integrator (leapfrog, predictor-corrector) adds to the half-step velocity to synchronise it at step `s`: a^s dt / 2,
+/// or nothing at s = 0 where the particles still carry v^0.
+fn synchronising_half(s: usize, dt: f64) -> f64 {
+    if s == 0 {
+        0.0
+    } else {
+        0.5 * dt
+    }
+}
+
 /// The end of a stepped run (MPM or a reference solver), whatever method made it.
 struct Stepped<const D: usize> {
     parts: MethodParts,
@@ -445,6 +474,7 @@ fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord 
     record.history = run.recorder.history;
     record.errors = run.recorder.errors;
     record.conservation = run.recorder.conservation;
+    record.probes = run.recorder.probes;
     record.diagnostics = run.diagnostics;
     record
 }
@@ -492,6 +522,7 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         errors: Default::default(),
         conservation: Default::default(),
         diagnostics: Default::default(),
+        probes: Vec::new(),
         reconstruction: None,
         elements: None,
         shape_functions: None,

@@ -1,15 +1,18 @@
 use nalgebra::SVector;
 
-use crate::benchmarks::Problem;
-use crate::output::{Conservation, Errors, History};
+use crate::benchmarks::{ProbeQuantity, Problem};
+use crate::output::{Conservation, Errors, History, ProbeRecord, REFERENCE_KINDS};
 use crate::particles::Particles;
 
 /// Appends sampled particle states, their errors against the exact solution and the mass
-/// totals.
+/// totals, and every step the values at the problem's probes.
 pub struct Recorder {
     pub history: History,
     pub errors: Errors,
     pub conservation: Conservation,
+    pub probes: Vec<ProbeRecord>,
+    /// What each of `probes` records.
+    quantities: Vec<ProbeQuantity>,
 }
 
 impl Recorder {
@@ -18,6 +21,72 @@ impl Recorder {
             history: History::default(),
             errors: Errors::default(),
             conservation: Conservation::default(),
+            probes: Vec::new(),
+            quantities: Vec::new(),
+        }
+    }
+
+    /// Resolves the problem's probes to the particles nearest them (once, after seeding).
+    /// The reference is `exact` where the problem has an exact solution, `static` where it
+    /// gives another one for probes only, else `none`.
+    pub fn attach_probes<const D: usize>(
+        &mut self,
+        problem: &dyn Problem<D>,
+        x0: &[SVector<f64, D>],
+    ) {
+        for probe in problem.probes() {
+            let Some(p) = probe.nearest(x0) else {
+                continue;
+            };
+            let [exact, other, none] = REFERENCE_KINDS;
+            let reference_kind = if problem.exact(&x0[p], 0.0).is_some() {
+                exact
+            } else if problem.probe_reference(&x0[p], 0.0).is_some() {
+                other
+            } else {
+                none
+            };
+            self.probes.push(ProbeRecord {
+                name: probe.name.to_string(),
+                particle: p as i64,
+                x0: x0[p].iter().copied().collect(),
+                quantity: probe.quantity.name().to_string(),
+                component: probe
+                    .quantity
+                    .component()
+                    .iter()
+                    .map(|&k| k as i64)
+                    .collect(),
+                reference_kind: reference_kind.to_string(),
+                ..ProbeRecord::default()
+            });
+            self.quantities.push(probe.quantity);
+        }
+    }
+
+    /// Appends each probe's value at step `step`, time `t`, with `velocity(p)` particle p's
+    /// velocity synchronised to `t`, and the problem's reference value there (NaN if none).
+    pub fn record_probes<const D: usize>(
+        &mut self,
+        step: usize,
+        t: f64,
+        particles: &Particles<D>,
+        velocity: impl Fn(usize) -> SVector<f64, D>,
+        problem: &dyn Problem<D>,
+    ) {
+        for (probe, quantity) in self.probes.iter_mut().zip(&self.quantities) {
+            let p = probe.particle as usize;
+            let displacement = particles.x[p] - particles.x0[p];
+            let value = quantity.of(&displacement, &velocity(p), &particles.stress[p]);
+            let reference = problem
+                .probe_reference(&particles.x0[p], t)
+                .map_or(f64::NAN, |r| {
+                    quantity.of(&r.displacement, &r.velocity, &r.stress)
+                });
+            probe.time.push(t);
+            probe.step.push(step as i64);
+            probe.value.push(value);
+            probe.reference.push(reference);
         }
     }
 

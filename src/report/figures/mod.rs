@@ -2,6 +2,7 @@
 
 mod along_bar;
 mod convergence;
+mod history;
 mod profiles;
 mod shape_functions;
 mod stability;
@@ -29,6 +30,8 @@ pub enum Scale {
 pub enum Marker {
     Circle,
     Square,
+    /// Where a diverged run stopped.
+    Cross,
 }
 
 /// One legend entry: markers at some points and a line through others, in one colour.
@@ -81,8 +84,8 @@ pub struct Figure {
 /// Every figure of the report: the experiment's own, or when it asks for none one convergence
 /// figure per group with all fields in the first norm (the shape-function figures for a
 /// shape-function benchmark, which does not refine). Figures without a single usable point
-/// are left out.
-pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
+/// are left out. A history figure of a probe no run records is an error.
+pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>, String> {
     let measures = experiment.measures();
     let default = [FigureSpec {
         kind: if experiment.kind == BenchmarkKind::ShapeFunctions {
@@ -95,6 +98,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
         by: None,
         select: Params::new(),
         stability: None,
+        probe: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -129,9 +133,12 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Figure> {
             FigureKind::ShapeFunctions => figures.extend(shape_functions::figures(
                 experiment, &selected, spec, &mut names,
             )),
+            FigureKind::History => {
+                figures.extend(history::figures(experiment, &selected, spec, &mut names)?)
+            }
         }
     }
-    figures
+    Ok(figures)
 }
 
 /// File names already given out: two figures may land on the same stem, and later ones get

@@ -1,0 +1,121 @@
+//! Probe histories (Molinos Figs 5-13): a probe's value against time, one line per run, with
+//! the benchmark's reference drawn once in grey. A diverged run's line stops where it did,
+//! marked with a cross.
+
+use super::{Figure, Marker, Names, Scale, Series};
+use crate::experiment::{Experiment, FigureSpec};
+use crate::output::{ProbeRecord, RunStatus, RunSummary};
+use crate::report::format::general;
+use crate::report::group::{group_runs, label, label_or_all, title_suffix};
+
+/// Names of the components of vectors and tensors, by index.
+const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
+
+/// One figure per group of the axes other than `by`, a line per run of the group. An error
+/// names the probe when no selected run records it, with the probes they do record.
+pub(super) fn figures(
+    experiment: &Experiment,
+    runs: &[&RunSummary],
+    spec: &FigureSpec,
+    names: &mut Names,
+) -> Result<Vec<Figure>, String> {
+    let Some(name) = spec.probe.as_deref() else {
+        return Ok(Vec::new());
+    };
+    if runs.iter().all(|run| probe_of(run, name).is_none()) {
+        let mut known: Vec<&str> = runs
+            .iter()
+            .flat_map(|run| run.probes.iter().map(|p| p.name.as_str()))
+            .collect();
+        known.sort_unstable();
+        known.dedup();
+        let known = if known.is_empty() {
+            "none".to_string()
+        } else {
+            known.join(", ")
+        };
+        return Err(format!(
+            "history figure: no selected run of {} records the probe '{name}'; the runs record: \
+             {known}",
+            experiment.name
+        ));
+    }
+    let drop: Vec<&str> = spec.by.as_deref().into_iter().collect();
+    let mut figures = Vec::new();
+    for group in group_runs(runs.iter().copied(), &drop) {
+        let probes: Vec<(&RunSummary, &ProbeRecord)> = group
+            .runs
+            .iter()
+            .filter_map(|run| Some((*run, probe_of(run, name)?)))
+            .filter(|(_, probe)| !probe.time.is_empty())
+            .collect();
+        let Some((_, first)) = probes.first() else {
+            continue;
+        };
+        let mut series: Vec<Series> = probes.iter().map(|(run, p)| line(run, p)).collect();
+        if let Some(reference) = reference(&probes) {
+            series.push(reference);
+        }
+        let which = format!("{name}_{}", label_or_all(&group.label));
+        figures.push(Figure {
+            file: names.file(experiment, &which),
+            title: format!("{}: {name}{}", experiment.name, title_suffix(&group.label)),
+            x_label: "t (s)".into(),
+            y_label: quantity_label(first),
+            scale: Scale::Linear,
+            series,
+        });
+    }
+    Ok(figures)
+}
+
+fn probe_of<'r>(run: &'r RunSummary, name: &str) -> Option<&'r ProbeRecord> {
+    run.probes.iter().find(|p| p.name == name)
+}
+
+/// The run's values over time; a diverged run ends in a cross at its last recorded value.
+fn line(run: &RunSummary, probe: &ProbeRecord) -> Series {
+    let points: Vec<(f64, f64)> = probe
+        .time
+        .iter()
+        .copied()
+        .zip(probe.value.iter().copied())
+        .collect();
+    let mut series = Series::line(label(&run.axes), points);
+    if run.status == RunStatus::Diverged {
+        if let Some(&last) = series.line.last() {
+            series.label = format!("{} (diverged at t = {})", series.label, general(last.0, 4));
+            series.markers = vec![last];
+            series.marker = Marker::Cross;
+        }
+    }
+    series
+}
+
+/// The reference of the first run that has one, in grey, labelled by its kind.
+fn reference(probes: &[(&RunSummary, &ProbeRecord)]) -> Option<Series> {
+    let (_, probe) = probes
+        .iter()
+        .find(|(_, p)| p.reference.iter().any(|r| r.is_finite()))?;
+    let points = probe
+        .time
+        .iter()
+        .copied()
+        .zip(probe.reference.iter().copied());
+    let mut series = Series::line(
+        probe.reference_kind.clone(),
+        points.filter(|(_, r)| r.is_finite()).collect(),
+    );
+    series.neutral = true;
+    Some(series)
+}
+
+/// E.g. `velocity x (m/s)`, `stress yy (Pa)`.
+fn quantity_label(probe: &ProbeRecord) -> String {
+    let component: String = probe
+        .component
+        .iter()
+        .map(|&k| AXIS_NAMES.get(k as usize).copied().unwrap_or("?"))
+        .collect();
+    format!("{} {component} ({})", probe.quantity, probe.unit())
+}
