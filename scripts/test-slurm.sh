@@ -231,6 +231,7 @@ if timeout 300 "$BIN" slurm "$file" --out "$failing" --shards "$SHARDS" --force 
 fi
 cat "$work/failing.out"
 grep -q 'a task failed' "$work/failing.out" || die "no 'a task failed' in the output above"
+grep -Eq "^shard [0-9]+/$SHARDS: FAILED" "$work/failing.out" || die "the failed shard is not named above"
 rm -r "$failing/ci_mms1d/runs/$blocked.h5"
 "$BIN" report "$failing/ci_mms1d" 2>"$work/report.err" || true
 cat "$work/report.err"

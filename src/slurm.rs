@@ -4,6 +4,7 @@
 //! waits through `sbatch --wait`, which exits with the largest exit code of the array's tasks
 //! (1 for a task ended by a signal) and needs no accounting database.
 
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::fs;
 use std::io::{self, BufRead, BufReader};
@@ -139,33 +140,38 @@ fn check_outcome(
     status: ExitStatus,
 ) -> Result<(), String> {
     let shards = plan.count();
-    let mut problems = Vec::new();
-    if !status.success() {
-        problems.push(format!("a task failed (sbatch --wait: {status})"));
-        for task in task_states(job_id).unwrap_or_default() {
-            if task.state != "COMPLETED" || task.exit_code != "0:0" {
-                eprintln!(
-                    "shard {}/{shards}: {} (exit code {}), see {}",
-                    task.task,
-                    task.state,
-                    task.exit_code,
-                    job.log_path(job_id, &task.task.to_string()).display()
-                );
-            }
-        }
-    }
     let missing = plan.missing(experiments, &job.out);
     for (shard, name, run_id) in &missing {
         eprintln!("missing run: {name}/{run_id} (shard {shard}/{shards})");
     }
-    let mut short: Vec<usize> = missing.iter().map(|m| m.0).collect();
-    short.dedup();
-    for shard in short {
+    // The shards to look at: those with runs missing, and the tasks that did not complete.
+    let mut bad: BTreeSet<usize> = missing.iter().map(|m| m.0).collect();
+    let states = (!status.success() || !bad.is_empty())
+        .then(|| task_states(job_id))
+        .flatten();
+    for task in states.iter().flatten() {
+        if task.state != "COMPLETED" || task.exit_code != "0:0" {
+            eprintln!(
+                "shard {}/{shards}: {} (exit code {})",
+                task.task, task.state, task.exit_code
+            );
+            bad.insert(task.task);
+        }
+    }
+    for shard in bad {
         let log = job.log_path(job_id, &shard.to_string());
-        eprintln!(
-            "shard {shard}/{shards} is incomplete: see {}",
-            log.display()
-        );
+        if log.exists() {
+            eprintln!("  log of shard {shard}/{shards}: {}", log.display());
+        } else {
+            eprintln!("  shard {shard}/{shards} left no log: its task did not start");
+        }
+    }
+    let mut problems = Vec::new();
+    if !status.success() {
+        problems.push(format!("a task failed (sbatch --wait: {status})"));
+        if states.is_none() {
+            eprintln!("  task logs: {}", job.log_path(job_id, "*").display());
+        }
     }
     let runs = plan.loads.iter().map(|l| l.runs).sum::<usize>();
     if !missing.is_empty() {
