@@ -3,7 +3,10 @@
 #   make            (= make all) install what is missing, build, run every experiments/*.yaml
 #                   into results/<name>/ and write its report
 #   make test       lint, unit tests, reduced matrices in tests/matrices/, HDF5 layout test,
-#                   `mpmlab report --check` on each reduced matrix
+#                   `mpmlab report --check` on each reduced matrix, then test-slurm
+#   make test-slurm the reduced matrices as a Slurm array on a one-node cluster started for
+#                   the test (installs slurm and munge when missing), compared bit for bit
+#                   with a single-machine run
 #   make bench      particle-steps per second per method and dimension
 #   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
 #   make clean-results   delete generated HDF5 run files (reports and figures stay)
@@ -48,7 +51,7 @@ RUN_FLAGS = $(if $(JOBS),--jobs $(JOBS)) $(if $(FORCE),--force)
 # die, step, apt_install, check_stems
 SH_LIB := source scripts/lib.sh
 
-.PHONY: all deps deps-system deps-python build lint test bench clean-results
+.PHONY: all deps deps-system deps-python build lint test test-slurm bench clean-results
 
 all: deps build
 	@$(SH_LIB)
@@ -129,6 +132,15 @@ test: deps lint build
 	  step "$(BIN) report $(TEST_OUT)/$$name --check"
 	  $(BIN) report "$(TEST_OUT)/$$name" --check
 	done
+	step "scripts/test-slurm.sh (make test-slurm)"
+	scripts/test-slurm.sh "$(BIN)" "$(VENV_PY)"
+
+# A one-node Slurm cluster in a temporary directory, stopped again by the script; see the
+# comment at the top of scripts/test-slurm.sh.
+test-slurm: deps build
+	@$(SH_LIB)
+	step "scripts/test-slurm.sh"
+	scripts/test-slurm.sh "$(BIN)" "$(VENV_PY)"
 
 bench: deps-system
 	@$(SH_LIB)

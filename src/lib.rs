@@ -1,6 +1,7 @@
 //! mpmlab: a research pipeline for the Material Point Method.
 //!
-//! Layers, top to bottom: `experiment` (YAML, matrix), `runner` (runs a matrix in parallel),
+//! Layers, top to bottom: `slurm` (a matrix as a Slurm job array), `shard` (splits a matrix
+//! for several machines), `experiment` (YAML, matrix), `runner` (runs a matrix in parallel),
 //! `output` (HDF5 layout), `report` (rates, tables, figures), `solver` (one run),
 //! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`. `linear_stability` holds
 //! the predicted stability bounds that `report` draws beside measured ones.
@@ -24,4 +25,6 @@ pub mod rng;
 pub mod runner;
 pub mod shape;
 pub mod shape_methods;
+pub mod shard;
+pub mod slurm;
 pub mod solver;

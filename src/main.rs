@@ -4,7 +4,10 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use mpmlab::collect::collect;
+use mpmlab::experiment::Experiment;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions};
+use mpmlab::shard::{Plan, Shard};
+use mpmlab::slurm;
 use mpmlab::{
     benchmarks, experiment, methods, reconstruction_methods, reference, report, shape_methods,
 };
@@ -28,6 +31,7 @@ enum Command {
     },
     /// Run every configuration of one or more experiment files.
     Run {
+        /// Experiment files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Parent directory of the results; each experiment writes to OUT/<name>/.
@@ -39,6 +43,49 @@ enum Command {
         /// Rerun runs whose file already exists.
         #[arg(long)]
         force: bool,
+        /// Run only shard K of N (1 <= K <= N) of the runs of all the files together. Every
+        /// shard computes the same split, so N machines can run one shard each into the same
+        /// OUT.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<Shard>,
+    },
+    /// Run the files' runs as a Slurm job array, one task per shard (`run --shard K/N`).
+    ///
+    /// Writes the array script to OUT/slurm/<job name>.sbatch and the experiment copies the
+    /// tasks read to OUT/<name>/experiment.yaml, submits the script with sbatch and prints the
+    /// job id. Options after `--` go to sbatch (e.g. -- --account=proj --qos=long) and
+    /// override the script's directives.
+    Slurm {
+        /// Experiment files; their runs together are split into the shards.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Parent directory of the results, on a file system every node sees.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Number of shards, one array task each (default: 8, or the number of runs if fewer).
+        #[arg(long)]
+        shards: Option<usize>,
+        /// sbatch --partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// sbatch --time of each task, e.g. 02:00:00.
+        #[arg(long, value_name = "HH:MM:SS")]
+        time: Option<String>,
+        /// sbatch --cpus-per-task; each task runs this many runs at a time.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+        cpus_per_task: u32,
+        /// Rerun runs whose file already exists.
+        #[arg(long)]
+        force: bool,
+        /// Wait until the array ends; exit non-zero if a task failed or a run is missing.
+        #[arg(long, conflicts_with = "dry_run")]
+        wait: bool,
+        /// Print the script and each shard's runs and estimated cost; submit nothing.
+        #[arg(long)]
+        dry_run: bool,
+        /// Further sbatch options, after `--`.
+        #[arg(last = true, value_name = "SBATCH_OPTION")]
+        sbatch_args: Vec<String>,
     },
     /// Write summary.csv, rates.csv, figures and report.md for a results directory.
     Report {
@@ -62,7 +109,35 @@ fn main() -> ExitCode {
             out,
             jobs,
             force,
-        } => run(&files, RunOptions { out, jobs, force }),
+            shard,
+        } => run(&files, RunOptions { out, jobs, force }, shard),
+        Command::Slurm {
+            files,
+            out,
+            shards,
+            partition,
+            time,
+            cpus_per_task,
+            force,
+            wait,
+            dry_run,
+            sbatch_args,
+        } => load_all(&files).and_then(|experiments| {
+            slurm::submit_study(
+                &experiments,
+                slurm::Options {
+                    out,
+                    shards,
+                    partition,
+                    time,
+                    cpus_per_task: cpus_per_task as usize,
+                    force,
+                    wait,
+                    dry_run,
+                    sbatch_args,
+                },
+            )
+        }),
         Command::Report { dir, check } => report_dir(&dir, check),
         Command::ListMethods => {
             list_methods();
@@ -94,17 +169,43 @@ fn expand(file: &Path, json: bool) -> Result<(), String> {
     Ok(())
 }
 
-fn run(files: &[PathBuf], options: RunOptions) -> Result<(), String> {
-    // Validate every file before running any, so a typo in the last file does not
-    // surface after hours of work.
-    let experiments = files
+/// Reads and validates every file before running any, so a typo in the last file does not
+/// surface after hours of work.
+fn load_all(files: &[PathBuf]) -> Result<Vec<Experiment>, String> {
+    files
         .iter()
         .map(|f| experiment::load(f).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect()
+}
+
+fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(), String> {
+    let mut experiments = load_all(files)?;
+    if let Some(shard) = shard {
+        let plan = Plan::new(&experiments, shard.count);
+        let load = plan.loads[shard.index - 1];
+        let total: usize = plan.loads.iter().map(|l| l.runs).sum();
+        eprintln!(
+            "shard {shard}: {} of {total} runs, estimated cost {:.3e} particle-steps",
+            load.runs, load.cost as f64
+        );
+        experiments = experiments
+            .iter()
+            .map(|e| plan.select(e, shard.index))
+            .collect();
+    }
+    // An experiment that cannot be written does not stop the others (a shard on a cluster
+    // does as much as it can); the command fails at the end.
+    let mut errors = Vec::new();
     for experiment in &experiments {
         let dir = results_dir(&options.out, experiment);
-        let outcome =
-            run_experiment(experiment, &options).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let outcome = match run_experiment(experiment, &options) {
+            Ok(outcome) => outcome,
+            Err(e) => {
+                eprintln!("error: {}: {e}", dir.display());
+                errors.push(experiment.name.clone());
+                continue;
+            }
+        };
         eprintln!(
             "{}: {} runs written, {} already present, {} diverged, {} failed -> {}",
             experiment.name,
@@ -118,13 +219,29 @@ fn run(files: &[PathBuf], options: RunOptions) -> Result<(), String> {
             eprintln!("  {line}");
         }
     }
-    Ok(())
+    match errors.as_slice() {
+        [] => Ok(()),
+        [one] => Err(format!("{one} could not be run completely")),
+        many => Err(format!(
+            "{} experiments could not be run completely: {}",
+            many.len(),
+            many.join(", ")
+        )),
+    }
 }
 
 fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
     let collected = collect(dir)?;
     for run_id in &collected.missing {
         eprintln!("missing run: {run_id}");
+    }
+    if !collected.missing.is_empty() {
+        eprintln!(
+            "{} of {} runs missing (listed above); the report covers the other {}",
+            collected.missing.len(),
+            collected.experiment.runs.len(),
+            collected.runs.len()
+        );
     }
     let rates = report::fit_rates(&collected.experiment, &collected.runs);
     let failures = check.then(|| report::check(&collected.experiment, &rates, &collected.runs));

@@ -4,12 +4,14 @@
 use std::fs;
 use std::io::{self, IsTerminal};
 use std::path::{Path, PathBuf};
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
+use crate::benchmarks::AnyProblem;
 use crate::experiment::{Experiment, RunSpec};
-use crate::output::{run_path, write_atomically, write_run, RunStatus};
+use crate::output::{run_path, write_run, RunStatus};
 use crate::params::get_usize;
 use crate::solver::simulate;
 
@@ -50,7 +52,7 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
         .partition(|run| options.force || !run_path(&dir, &run.run_id).exists());
     let mut todo = todo;
     // Longest first, so the pool does not end waiting on one large run.
-    todo.sort_by_key(|run| std::cmp::Reverse(estimated_cost(run)));
+    todo.sort_by_cached_key(|run| std::cmp::Reverse(estimated_cost(run)));
 
     let progress = progress_bar(&experiment.name, todo.len());
     let pool = rayon::ThreadPoolBuilder::new()
@@ -87,18 +89,50 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
     Ok(outcome)
 }
 
-/// Particle-steps, up to a constant: cells^(dim+1) ppc^dim (the step count grows with cells).
-fn estimated_cost(run: &RunSpec) -> usize {
+/// A run's cost in particle-steps: its particles (`cells * ppc` per axis) times the time
+/// steps its problem takes to the final time. A reconstruction benchmark takes no steps and
+/// costs its points. The runner starts the costliest runs first and `shard` balances shards
+/// by this, across experiments, so it is computed from the validated parameters alone and is
+/// the same on every machine.
+pub fn estimated_cost(run: &RunSpec) -> u64 {
     let dim = crate::benchmarks::info(&run.benchmark).map_or(1, |b| b.dim) as u32;
-    let cells = get_usize(&run.params, "cells").unwrap_or(1);
-    let ppc = get_usize(&run.params, "ppc").unwrap_or(1);
-    cells
-        .saturating_pow(dim + 1)
-        .saturating_mul(ppc.saturating_pow(dim))
+    let cells = get_usize(&run.params, "cells").unwrap_or(1) as u64;
+    let ppc = get_usize(&run.params, "ppc").unwrap_or(1) as u64;
+    let particles = cells.saturating_mul(ppc).saturating_pow(dim);
+    // Building a problem only reads its parameters (dt, step count); it has no particles yet.
+    let steps = match crate::benchmarks::build(&run.benchmark, &run.params) {
+        Ok(AnyProblem::D1(problem)) => problem.steps(),
+        Ok(AnyProblem::D2(problem)) => problem.steps(),
+        Err(_) => 1,
+    };
+    particles.saturating_mul(steps.max(1) as u64)
 }
 
-fn write_experiment_copy(dir: &Path, text: &str) -> io::Result<()> {
-    write_atomically(&dir.join(EXPERIMENT_COPY), |tmp| fs::write(tmp, text))
+/// Shards of one study, on several hosts, all write the same copy: an identical copy is left
+/// alone, and a new one is written under a temporary name unique to this host, process and
+/// moment (`write_atomically` names it by process id only, which processes on different hosts
+/// can share) and renamed into place, so a reader never sees a partial copy.
+pub fn write_experiment_copy(dir: &Path, text: &str) -> io::Result<()> {
+    let path = dir.join(EXPERIMENT_COPY);
+    if fs::read_to_string(&path).is_ok_and(|old| old == text) {
+        return Ok(());
+    }
+    let host = fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::env::var("HOSTNAME"))
+        .unwrap_or_default();
+    let nanos = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let tmp = dir.join(format!(
+        ".{EXPERIMENT_COPY}.tmp-{}-{}-{nanos}",
+        host.trim(),
+        std::process::id()
+    ));
+    let written = fs::write(&tmp, text).and_then(|()| fs::rename(&tmp, &path));
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    written
 }
 
 /// A bar on a terminal; nothing when stderr is piped or redirected.

@@ -1,0 +1,132 @@
+"""Compares two results directories (`mpmlab run --out A` and `--out B`) bit for bit.
+
+    python scripts/compare_results.py A B
+
+For every experiment directory of A (one with an experiment.yaml) B must have the same
+experiment.yaml, the same run files and no temporary files left, and every pair of run files
+must hold the same groups, datasets and attributes: every dataset with the same dtype, shape
+and bytes, every attribute equal. Excluded, because it records time: the root attribute
+`wall_seconds` of each run file, and the `wall_seconds` column of summary.csv. The report
+files (rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
+Exits 1 listing the differences.
+"""
+
+import csv
+import io
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+TIME_ATTRS = {("/", "wall_seconds")}
+TIME_COLUMNS = {"wall_seconds"}
+
+
+def value_bytes(value):
+    """A comparable form of a dataset's or attribute's value: its dtype, shape and bytes."""
+    array = np.asarray(value)
+    if array.dtype.kind == "O":  # variable-length strings
+        return (array.shape, [str(v) for v in array.ravel()])
+    return (array.dtype.str, array.shape, array.tobytes())
+
+
+def contents(path):
+    """{(object path, kind, name): comparable value} for every dataset and attribute."""
+    items = {}
+    with h5py.File(path, "r") as f:
+
+        def add(name, obj):
+            key = "/" + name if name else "/"
+            if isinstance(obj, h5py.Dataset):
+                items[(key, "dataset", "")] = value_bytes(obj[()])
+            else:
+                items[(key, "group", "")] = None
+            for attr, value in obj.attrs.items():
+                if (key, attr) not in TIME_ATTRS:
+                    items[(key, "attr", attr)] = value_bytes(value)
+
+        add("", f)
+        f.visititems(add)
+    return items
+
+
+def summary_without_time(path):
+    rows = list(csv.reader(io.StringIO(path.read_text())))
+    keep = [i for i, name in enumerate(rows[0]) if name not in TIME_COLUMNS]
+    return [[row[i] for i in keep] for row in rows]
+
+
+def compare_experiment(a, b, problems, counts):
+    name = a.name
+    if not (b / "experiment.yaml").is_file():
+        problems.append(f"{name}: no experiment.yaml in {b}")
+        return
+    if (a / "experiment.yaml").read_bytes() != (b / "experiment.yaml").read_bytes():
+        problems.append(f"{name}: experiment.yaml differs")
+    for d in (a, b):
+        leftovers = [p.name for p in (d / "runs").glob(".*")]
+        if leftovers:
+            problems.append(f"{d}: temporary files left: {leftovers}")
+    runs_a = sorted(p.name for p in (a / "runs").glob("*.h5"))
+    runs_b = sorted(p.name for p in (b / "runs").glob("*.h5"))
+    if runs_a != runs_b:
+        only_a = sorted(set(runs_a) - set(runs_b))
+        only_b = sorted(set(runs_b) - set(runs_a))
+        problems.append(f"{name}: run files differ: only in A {only_a}, only in B {only_b}")
+    for run in sorted(set(runs_a) & set(runs_b)):
+        ca, cb = contents(a / "runs" / run), contents(b / "runs" / run)
+        if ca.keys() != cb.keys():
+            diff = sorted(set(ca) ^ set(cb))
+            problems.append(f"{name}/{run}: objects or attributes differ: {diff[:5]}")
+        for key in sorted(set(ca) & set(cb)):
+            if ca[key] != cb[key]:
+                problems.append(f"{name}/{run}: {key[1]} {key[0]} {key[2]} differs")
+        counts["runs"] += 1
+        counts["datasets"] += sum(1 for k in ca if k[1] == "dataset")
+        counts["attributes"] += sum(1 for k in ca if k[1] == "attr")
+    for report in ["rates.csv", "report.md"] + sorted(
+        str(p.relative_to(a)) for p in a.glob("figures/*.png")
+    ):
+        if not (a / report).exists():
+            continue
+        if not (b / report).exists():
+            problems.append(f"{name}: {report} missing in B")
+        elif (a / report).read_bytes() != (b / report).read_bytes():
+            problems.append(f"{name}: {report} differs")
+        else:
+            counts["report files"] += 1
+    if (a / "summary.csv").exists():
+        if not (b / "summary.csv").exists():
+            problems.append(f"{name}: summary.csv missing in B")
+        elif summary_without_time(a / "summary.csv") != summary_without_time(b / "summary.csv"):
+            problems.append(f"{name}: summary.csv differs (outside wall_seconds)")
+        else:
+            counts["report files"] += 1
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.exit(__doc__)
+    a, b = Path(argv[1]), Path(argv[2])
+    experiments = sorted(p.parent for p in a.glob("*/experiment.yaml"))
+    if not experiments:
+        sys.exit(f"{a}: no experiment directories")
+    problems = []
+    counts = {"runs": 0, "datasets": 0, "attributes": 0, "report files": 0}
+    for experiment in experiments:
+        compare_experiment(experiment, b / experiment.name, problems, counts)
+    for problem in problems[:50]:
+        print(f"DIFFERENT: {problem}")
+    print(
+        f"{len(experiments)} experiments, {counts['runs']} run files: {counts['datasets']} "
+        f"datasets and {counts['attributes']} attributes compared bit for bit (excluded: the "
+        f"root attribute wall_seconds), {counts['report files']} report files byte for byte "
+        f"(summary.csv without its wall_seconds column): "
+        + ("identical" if not problems else f"{len(problems)} differences")
+    )
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
