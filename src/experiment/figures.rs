@@ -9,7 +9,7 @@ use super::measures::{error_field, norm};
 use super::select::axis_key;
 use super::space::ParamSpace;
 use super::stability;
-use super::yaml::{child_field, find, item_field, Entry, Node};
+use super::yaml::{child_field, find, item_field, Entry, Node, NodeKind};
 use super::{FigureKind, FigureSpec};
 
 /// What a profile figure shows without `fields` (Wobbes Fig 4).
@@ -69,8 +69,8 @@ fn figure(
         (None, _) => measures.fields.iter().map(|f| f.to_string()).collect(),
     };
     let by = match find(&entries, "by") {
-        Some(e) => Some(axis_key(e.value, &child_field(parent, "by"), space)?),
-        None => None,
+        Some(e) => by_axes(e.value, &child_field(parent, "by"), space, kind)?,
+        None => Vec::new(),
     };
     let probe = match (find(&entries, "probe"), kind) {
         (Some(e), _) => Some(e.value.as_text(&child_field(parent, "probe"))?.to_string()),
@@ -92,6 +92,29 @@ fn figure(
         stability,
         probe,
     })
+}
+
+/// The axis of `by`, or for a history figure also a list of axes.
+fn by_axes(
+    node: &Node,
+    field: &str,
+    space: &ParamSpace,
+    kind: &FigureKind,
+) -> Result<Vec<String>, ConfigError> {
+    let NodeKind::List(items) = &node.kind else {
+        return Ok(vec![axis_key(node, field, space)?]);
+    };
+    if *kind != FigureKind::History {
+        return Err(node.expected(field, "one matrix axis (a list applies to history figures)"));
+    }
+    if items.is_empty() {
+        return Err(node.expected(field, "a matrix axis or a non-empty list of them"));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| axis_key(item, &item_field(field, i), space))
+        .collect()
 }
 
 /// The keys a figure of `kind` takes besides `kind` and selectors.

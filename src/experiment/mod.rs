@@ -205,8 +205,10 @@ pub struct FigureSpec {
     pub kind: FigureKind,
     pub fields: Vec<String>,
     pub norm: String,
-    /// Axis whose values become separate curves in one figure (others make separate figures).
-    pub by: Option<String>,
+    /// Axes whose values become separate curves in one figure (others make separate figures):
+    /// one at most, except for history figures, whose lines may differ in several (a method
+    /// with a gamma axis beside methods without).
+    pub by: Vec<String>,
     /// Axis values a run must have to be drawn; empty = every run.
     pub select: Params,
     /// Stability and growth figures only.

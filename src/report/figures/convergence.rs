@@ -17,10 +17,8 @@ pub(super) fn figures(
     spec: &FigureSpec,
     names: &mut Names,
 ) -> Vec<Figure> {
-    let drop: Vec<&str> = [Some(REFINEMENT_AXIS), spec.by.as_deref()]
-        .into_iter()
-        .flatten()
-        .collect();
+    let mut drop = vec![REFINEMENT_AXIS];
+    drop.extend(spec.by.iter().map(String::as_str));
     group_runs(runs.iter().copied(), &drop)
         .into_iter()
         .filter_map(|group| {
@@ -50,7 +48,7 @@ fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
     for sub in group_runs(runs.iter().copied(), &[REFINEMENT_AXIS]) {
         let by = spec
             .by
-            .as_ref()
+            .first()
             .and_then(|axis| sub.axes.get(axis).map(|value| format!(", {axis}={value}")))
             .unwrap_or_default();
         for field in &spec.fields {

@@ -40,7 +40,7 @@ pub(super) fn figures(
             experiment.name
         ));
     }
-    let drop: Vec<&str> = spec.by.as_deref().into_iter().collect();
+    let drop: Vec<&str> = spec.by.iter().map(String::as_str).collect();
     let mut figures = Vec::new();
     for group in group_runs(runs.iter().copied(), &drop) {
         let probes: Vec<(&RunSummary, &ProbeRecord)> = group
@@ -52,7 +52,7 @@ pub(super) fn figures(
         let Some((_, first)) = probes.first() else {
             continue;
         };
-        let mut series: Vec<Series> = probes.iter().map(|(run, p)| line(run, p)).collect();
+        let mut series: Vec<Series> = probes.iter().map(|(run, p)| line(run, p, &drop)).collect();
         if let Some(reference) = reference(&probes) {
             series.push(reference);
         }
@@ -73,15 +73,25 @@ fn probe_of<'r>(run: &'r RunSummary, name: &str) -> Option<&'r ProbeRecord> {
     run.probes.iter().find(|p| p.name == name)
 }
 
-/// The run's values over time; a diverged run ends in a cross at its last recorded value.
-fn line(run: &RunSummary, probe: &ProbeRecord) -> Series {
+/// The run's values over time, labelled with its values of the `by` axes (all its axes when
+/// there are none); a diverged run ends in a cross at its last recorded value.
+fn line(run: &RunSummary, probe: &ProbeRecord, by: &[&str]) -> Series {
     let points: Vec<(f64, f64)> = probe
         .time
         .iter()
         .copied()
         .zip(probe.value.iter().copied())
         .collect();
-    let mut series = Series::line(label(&run.axes), points);
+    let axes = if by.is_empty() {
+        run.axes.clone()
+    } else {
+        run.axes
+            .iter()
+            .filter(|(k, _)| by.contains(&k.as_str()))
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect()
+    };
+    let mut series = Series::line(label(&axes), points);
     if run.status == RunStatus::Diverged {
         if let Some(&last) = series.line.last() {
             series.label = format!("{} (diverged at t = {})", series.label, general(last.0, 4));

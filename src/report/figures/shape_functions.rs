@@ -20,7 +20,7 @@ pub(super) fn figures(
     names: &mut Names,
 ) -> Vec<Figure> {
     let mut drop = vec![METHOD_AXIS];
-    drop.extend(spec.by.as_deref());
+    drop.extend(spec.by.iter().map(String::as_str));
     let mut figures = Vec::new();
     for group in group_runs(selected.iter().copied(), &drop) {
         let mut runs: Vec<(&RunSummary, &ShapeFunctionRecord)> = group
