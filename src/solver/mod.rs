@@ -196,7 +196,7 @@ impl<'a, const D: usize> Run<'a, D> {
 
     fn execute(mut self) -> RunRecord {
         let (steps, outcome) = self.step_all();
-        stepped_record(
+        let mut record = stepped_record(
             self.spec,
             Stepped {
                 parts: self.method.into(),
@@ -217,7 +217,20 @@ impl<'a, const D: usize> Run<'a, D> {
                     },
                 },
             },
-        )
+        );
+        // The file counts them; the message makes them visible in summary.csv and report.md.
+        let failures = record.diagnostics.lme_failures;
+        if failures > 0 {
+            let note = format!(
+                "{failures} LME evaluations stopped short of the Newton tolerance \
+                 (/diagnostics lme_failures)"
+            );
+            if !record.message.is_empty() {
+                record.message.push_str("; ");
+            }
+            record.message.push_str(&note);
+        }
+        record
     }
 
     /// Steps to the final time; returns the steps completed and, on divergence, the step
