@@ -92,13 +92,17 @@ impl IntegratorKind {
     ];
 
     pub fn name(self) -> &'static str {
-        let index = Self::ALL.iter().position(|&k| k == self);
-        Self::NAMES[index.expect("every integrator is listed in ALL")]
+        match self {
+            IntegratorKind::Leapfrog => Self::NAMES[0],
+            IntegratorKind::Musl => Self::NAMES[1],
+            IntegratorKind::Euler => Self::NAMES[2],
+            IntegratorKind::EulerCorrected => Self::NAMES[3],
+            IntegratorKind::PredictorCorrector => Self::NAMES[4],
+        }
     }
 
     fn from_name(name: &str) -> Option<Self> {
-        let index = Self::NAMES.iter().position(|&n| n == name)?;
-        Some(Self::ALL[index])
+        Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
     /// Whether the particles carry v^{s-1/2} between steps and start with a half kick: the
@@ -446,7 +450,8 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
                     format!(
                         "{key} applies to LME methods only ({}), not to {}; put the LME runs \
                          in a matrix block of their own",
-                        lme_preset_names().join(", "),
+                        preset_names_where(|m| matches!(m.shape, ShapeKind::LocalMaxEnt(_)))
+                            .join(", "),
                         preset.name
                     ),
                 ));
@@ -472,7 +477,7 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
                      integrator can be replaced for the methods with the Shepard transfer: {}",
                     preset.name,
                     method.transfer,
-                    shepard_preset_names().join(", ")
+                    preset_names_where(|m| m.transfer == TransferKind::Shepard).join(", ")
                 ),
             ));
         }
@@ -489,18 +494,11 @@ fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {
     valid.map_err(|e| ParamError::new(GAMMA_KEY, e.to_string()))
 }
 
-fn lme_preset_names() -> Vec<&'static str> {
+/// The presets whose composition satisfies `keep`.
+fn preset_names_where(keep: impl Fn(&Method) -> bool) -> Vec<&'static str> {
     PRESETS
         .iter()
-        .filter(|p| matches!(p.method.shape, ShapeKind::LocalMaxEnt(_)))
-        .map(|p| p.name)
-        .collect()
-}
-
-fn shepard_preset_names() -> Vec<&'static str> {
-    PRESETS
-        .iter()
-        .filter(|p| p.method.transfer == TransferKind::Shepard)
+        .filter(|p| keep(&p.method))
         .map(|p| p.name)
         .collect()
 }
@@ -543,5 +541,20 @@ impl fmt::Display for Method {
             "shape={} transfer={} integrate={}",
             self.shape, self.transfer, self.integrator
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_integrator_is_found_by_its_name() {
+        for kind in IntegratorKind::ALL {
+            assert_eq!(IntegratorKind::from_name(kind.name()), Some(kind));
+        }
+        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
+        assert_eq!(names, IntegratorKind::NAMES);
+        assert_eq!(IntegratorKind::from_name("rk4"), None);
     }
 }

@@ -54,11 +54,11 @@ pub(crate) fn settable_kind(
     } else {
         &[]
     };
-    let mut settable = info.params.iter().chain(method_params);
-    match settable.clone().find(|p| p.key == entry.key) {
+    let settable = || info.params.iter().chain(method_params);
+    match settable().find(|p| p.key == entry.key) {
         Some(p) => Ok(ValueKind::Param(p.kind)),
         None => {
-            let valid = settable.by_ref().map(|p| p.key).chain([METHOD_KEY]);
+            let valid = settable().map(|p| p.key).chain([METHOD_KEY]);
             Err(ConfigError::at(
                 entry.key_pos,
                 child_field(parent, entry.key),
