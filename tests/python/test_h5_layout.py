@@ -72,7 +72,7 @@ CONSERVATIVE_METHODS = (
     "mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped", "bsmpm", "bsmpm_tls", "ddmpm", "ddmpm_tls",
     "ddmpm_tls_lumped",
 )
-DIAGNOSTICS = ("reconstructions", "rank_deficient", "grid_crossings")
+DIAGNOSTICS = ("reconstructions", "rank_deficient", "grid_crossings", "lme_failures")
 
 RUN_ID = re.compile(r"^.+-[0-9a-f]{12}$")
 
@@ -494,6 +494,10 @@ def test_diagnostics(run):
         assert counters["reconstructions"] == 0 and counters["rank_deficient"] == 0, (
             "the original MPM makes no least-squares fits"
         )
+    if not str(run.attrs["shape"]).startswith("lme"):
+        assert counters["lme_failures"] == 0, "only the LME basis solves for its weights"
+    elif counters["lme_failures"] > 0:
+        assert "lme_failures" in str(run.attrs["message"]), "LME failures must be named in message"
 
 
 # --------------------------------------------------------------------------------------------
