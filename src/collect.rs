@@ -6,8 +6,8 @@ mod compare;
 
 use std::path::Path;
 
-use crate::experiment::FigureKind;
 use crate::experiment::{self, Experiment};
+use crate::experiment::{FigureKind, TableKind};
 use crate::output::{read_probes, read_profile, read_summary, run_path, RunSummary};
 use crate::runner::EXPERIMENT_COPY;
 
@@ -36,7 +36,7 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
             if wants_profiles(&experiment) {
                 run.profile = read_profile(&path)?;
             }
-            if draws_histories(&experiment) {
+            if reads_probes(&experiment) {
                 run.probes = read_probes(&path)?;
             }
             runs.push(run);
@@ -63,10 +63,15 @@ fn wants_profiles(experiment: &Experiment) -> bool {
             .any(|f| f.kind == FigureKind::Profile)
 }
 
-/// Whether the report draws probe histories, which need the `/probes` of every run.
-fn draws_histories(experiment: &Experiment) -> bool {
+/// Whether the report needs the `/probes` of every run: to draw their histories, or for the
+/// wiggle measures of its errors tables.
+fn reads_probes(experiment: &Experiment) -> bool {
     experiment
         .figures
         .iter()
         .any(|f| f.kind == FigureKind::History)
+        || experiment
+            .tables
+            .iter()
+            .any(|t| t.kind == TableKind::Errors)
 }

@@ -68,9 +68,10 @@ pub enum IntegratorKind {
     /// momenta, and the stress from the nodal velocity rebuilt from the updated particle
     /// velocities, which stays bounded where a nodal mass vanishes.
     EulerCorrected,
-    /// The explicit Newmark predictor-corrector (gamma = 1/2, beta = 0) of Molinos et al.
-    /// sec 4: a nodal velocity carried by the grid, predicted with half the old acceleration,
-    /// corrected with half the new one; the particles move with the predictor (eq 28).
+    /// The explicit Newmark predictor-corrector (gamma = 1/2) of Molinos et al. sec 4 as the
+    /// authors' code runs it: the predictor mapped from the particles' v_p + dt/2 a_p every
+    /// step, the stress from it, the corrector with half the new acceleration
+    /// (`integrate::predictor_corrector`).
     PredictorCorrector,
 }
 
@@ -106,19 +107,15 @@ impl IntegratorKind {
     }
 
     /// Whether the particles carry v^{s-1/2} between steps and start with a half kick: the
-    /// leapfrog, and the predictor-corrector, whose particle velocities take half of the
-    /// acceleration in its corrector and half in the next predictor.
+    /// leapfrog alone.
     pub fn staggers_velocity(self) -> bool {
-        matches!(
-            self,
-            IntegratorKind::Leapfrog | IntegratorKind::PredictorCorrector
-        )
+        self == IntegratorKind::Leapfrog
     }
 
-    /// Whether the particles move with the start-of-step nodal velocity (eqs 21-24) rather
-    /// than the updated one.
-    pub fn drifts_with_start_velocity(self) -> bool {
-        matches!(self, IntegratorKind::Euler | IntegratorKind::EulerCorrected)
+    /// Whether the strain rate comes from the nodal velocity rebuilt from the moved
+    /// particles (MUSL, eqs 23-24) rather than from the grid solve's.
+    pub fn remaps_velocity(self) -> bool {
+        matches!(self, IntegratorKind::Musl | IntegratorKind::EulerCorrected)
     }
 }
 

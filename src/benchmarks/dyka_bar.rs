@@ -87,7 +87,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     dim: 1,
     source: "Molinos et al., sec 6.1, appendix A (Dyka & Ingel 1995)",
     description: "linear-elastic bar, x = 0 fixed, x = L free, v0 on the last quarter; probes \
-                  free_end_velocity, mid_stress",
+                  free_end_velocity, quarter_stress, mid_stress",
     params: PARAMS,
     check: check_params,
 };
@@ -261,16 +261,22 @@ impl Problem<1> for DykaBar {
         })
     }
 
-    /// The velocity of the particle nearest the free end and the stress at mid-length (Molinos
-    /// Figs 5-8, 12-13). With an even number of cells and one particle per cell, X = L/2 is a
-    /// cell face with a particle either side; the tie picks the lower, X = L/2 - h/2 (0.0650 m
-    /// with the defaults).
+    /// The velocity of the particle nearest the free end (Molinos Figs 5-8, 12), the stress in
+    /// the middle of the last quarter, X = 7L/8 (Fig 13: "the stress in the last quarter"), and
+    /// the stress at mid-length. With 40 cells and one particle per cell both X = 7L/8 and
+    /// X = L/2 are cell faces with a particle either side; the tie picks the lower, X = 7L/8 -
+    /// h/2 (0.1150 m) and X = L/2 - h/2 (0.0650 m) with the defaults.
     fn probes(&self) -> Vec<Probe<1>> {
         vec![
             Probe {
                 name: "free_end_velocity",
                 at: SVector::repeat(self.length),
                 quantity: ProbeQuantity::Velocity(0),
+            },
+            Probe {
+                name: "quarter_stress",
+                at: SVector::repeat(0.875 * self.length),
+                quantity: ProbeQuantity::Stress(0, 0),
             },
             Probe {
                 name: "mid_stress",
@@ -458,7 +464,7 @@ mod tests {
     }
 
     #[test]
-    fn probes_are_the_free_end_velocity_and_the_mid_stress() {
+    fn probes_are_the_free_end_velocity_and_the_quarter_and_mid_stresses() {
         let bar = bar(&[]);
         let h = cell(&bar);
         let x0: Vec<SVector<f64, 1>> = (0..40)
@@ -466,8 +472,10 @@ mod tests {
             .collect();
         let probes = bar.probes();
         assert_eq!(probes[0].nearest(&x0), Some(39));
-        // X = 19.5 h and 20.5 h are equally far from L/2 = 20 h: the lower wins.
-        assert_eq!(probes[1].nearest(&x0), Some(19));
+        // X = 34.5 h and 35.5 h are equally far from 7L/8 = 35 h, X = 19.5 h and 20.5 h from
+        // L/2 = 20 h: the lower wins.
+        assert_eq!(probes[1].nearest(&x0), Some(34));
+        assert_eq!(probes[2].nearest(&x0), Some(19));
     }
 
     #[test]

@@ -9,6 +9,8 @@ use std::fmt;
 
 use nalgebra::SVector;
 
+pub use deform::deform_particles;
+
 use crate::reconstruct::GridState;
 use crate::shape::DomainFault;
 

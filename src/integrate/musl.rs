@@ -3,12 +3,11 @@
 //! from the updated particle velocities (v_i^L, eq 36) and used for the velocity gradient.
 //! N and grad N are taken at x_p^t throughout the step: the grid moves with the material
 //! until it is reset at the end (Tran: "at that moment, the grid configuration is reset").
+//! The deformation with v_i^L is `deform::deform_particles` (eqs 37-40).
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 
-use super::deform::deform_particle;
 use super::Divergence;
-use crate::material::Material;
 use crate::particles::Particles;
 use crate::reconstruct::GridState;
 use crate::shape::Stencils;
@@ -38,25 +37,6 @@ pub fn move_particles<const D: usize>(
         }
         particles.v[p] += a * dt;
         particles.x[p] += v * dt;
-    }
-    Ok(())
-}
-
-/// Eqs 37-40 with grad N (eq 37 prints N): grad v_p = sum_i v_i^L (x) grad N_ip, then F, J
-/// and the stress.
-pub fn deform_particles<const D: usize>(
-    stencils: &Stencils<D>,
-    particles: &mut Particles<D>,
-    remapped: &[SVector<f64, D>],
-    dt: f64,
-    material: &Material,
-) -> Result<(), Divergence> {
-    for p in 0..particles.len() {
-        let grad_v: SMatrix<f64, D, D> = stencils
-            .of(p)
-            .map(|(i, _, g)| remapped[i] * g.transpose())
-            .sum();
-        deform_particle(particles, p, &grad_v, dt, true, material)?;
     }
     Ok(())
 }

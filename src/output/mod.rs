@@ -190,7 +190,7 @@ mod writer;
 
 pub use atomic::{run_path, write_atomically, write_run};
 pub use elements::ElementRecord;
-pub use probes::{ProbeRecord, REFERENCE_KINDS};
+pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
 pub use reader::{read_probes, read_profile, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{

@@ -5,7 +5,7 @@
 use hdf5::{File, Group};
 
 use super::reader::{read_i64, read_str};
-use super::writer::{attr_i64, attr_str, dataset};
+use super::writer::{attr_f64, attr_i64, attr_str, dataset};
 
 const GROUP: &str = "probes";
 const TIME: &str = "time";
@@ -16,6 +16,9 @@ const PARTICLE: &str = "particle";
 const X0: &str = "x0";
 const QUANTITY: &str = "quantity";
 const COMPONENT: &str = "component";
+const TOTAL_VARIATION: &str = "total_variation";
+const REFERENCE_TOTAL_VARIATION: &str = "reference_total_variation";
+const OVERSHOOT: &str = "overshoot";
 
 /// What a probe's `reference` dataset holds: the exact solution, another solution the
 /// benchmark gives (the quasi-static one of the Andersen block), or nothing (NaN).
@@ -41,7 +44,41 @@ pub struct ProbeRecord {
     pub reference: Vec<f64>,
 }
 
+/// How much a probe's history wiggles, against its reference (Molinos et al. sec 4: the
+/// predictor-corrector "mitigates the presence of wiggles and overshoot").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wiggles {
+    /// sum_k |value_{k+1} - value_k| over the recorded steps.
+    pub total_variation: f64,
+    /// The same of the reference; NaN where there is none.
+    pub reference_total_variation: f64,
+    /// How far the value goes past the range of the reference over the whole history,
+    /// max(max value - max reference, min reference - min value, 0); NaN without a reference.
+    pub overshoot: f64,
+}
+
 impl ProbeRecord {
+    /// The wiggle measures of the recorded history.
+    pub fn wiggles(&self) -> Wiggles {
+        let has_reference =
+            !self.reference.is_empty() && self.reference.iter().all(|r| r.is_finite());
+        let (low, high) = range(&self.value);
+        let (ref_low, ref_high) = range(&self.reference);
+        Wiggles {
+            total_variation: total_variation(&self.value),
+            reference_total_variation: if has_reference {
+                total_variation(&self.reference)
+            } else {
+                f64::NAN
+            },
+            overshoot: if has_reference {
+                (high - ref_high).max(ref_low - low).max(0.0)
+            } else {
+                f64::NAN
+            },
+        }
+    }
+
     /// The unit of the quantity.
     pub fn unit(&self) -> &'static str {
         match self.quantity.as_str() {
@@ -70,8 +107,29 @@ pub(super) fn write(file: &File, probes: &[ProbeRecord]) -> hdf5::Result<()> {
         attr_str(&g, QUANTITY, &probe.quantity)?;
         attr_list(&g, COMPONENT, &probe.component)?;
         attr_str(&g, REFERENCE, &probe.reference_kind)?;
+        let wiggles = probe.wiggles();
+        attr_f64(&g, TOTAL_VARIATION, wiggles.total_variation)?;
+        attr_f64(
+            &g,
+            REFERENCE_TOTAL_VARIATION,
+            wiggles.reference_total_variation,
+        )?;
+        attr_f64(&g, OVERSHOOT, wiggles.overshoot)?;
     }
     Ok(())
+}
+
+fn total_variation(values: &[f64]) -> f64 {
+    values.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
+}
+
+/// The least and the largest value; (inf, -inf) when there is none.
+fn range(values: &[f64]) -> (f64, f64) {
+    values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
 }
 
 /// Every probe of the file, by name; none when it has no `/probes`.
@@ -103,4 +161,36 @@ fn attr_list<T: hdf5::H5Type>(g: &Group, name: &str, values: &[T]) -> hdf5::Resu
         .shape(values.len())
         .create(name)?
         .write_raw(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn probe(value: &[f64], reference: &[f64]) -> ProbeRecord {
+        ProbeRecord {
+            value: value.to_vec(),
+            reference: reference.to_vec(),
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn wiggles_of_a_ringing_history() {
+        // The reference steps from 5 to 0; the value overshoots to 6, undershoots to -1 and
+        // rings back: total variation 1 + 7 + 1 = 9 against 5, overshoot 1.
+        let w = probe(&[5.0, 6.0, -1.0, 0.0], &[5.0, 5.0, 0.0, 0.0]).wiggles();
+        assert_eq!(w.total_variation, 9.0);
+        assert_eq!(w.reference_total_variation, 5.0);
+        assert_eq!(w.overshoot, 1.0);
+        // Inside the reference's range there is no overshoot.
+        assert_eq!(probe(&[4.0, 1.0], &[5.0, 0.0]).wiggles().overshoot, 0.0);
+    }
+
+    #[test]
+    fn no_reference_no_comparison() {
+        let w = probe(&[1.0, 2.0], &[f64::NAN, f64::NAN]).wiggles();
+        assert_eq!(w.total_variation, 1.0);
+        assert!(w.reference_total_variation.is_nan() && w.overshoot.is_nan());
+    }
 }

@@ -31,6 +31,44 @@ pub fn particles_to_grid<const D: usize>(
     momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
 }
 
+/// The Shepard mapping of mass and of one velocity per particle, with no forces: m_i as in
+/// `particles_to_grid`, v_i = sum_p M_p u_p N_ip / m_i, `grid.force` cleared (the
+/// predictor of `integrate::predictor_corrector` maps u_p = v_p + dt/2 a_p this way).
+pub fn map_velocity<const D: usize>(
+    stencils: &Stencils<D>,
+    mass: &[f64],
+    velocity: &[SVector<f64, D>],
+    grid: &mut GridState<D>,
+) {
+    grid.clear();
+    for (p, (&m, u)) in mass.iter().zip(velocity).enumerate() {
+        let mu = u * m;
+        for (i, w, _) in stencils.of(p) {
+            grid.mass[i] += m * w;
+            grid.velocity[i] += mu * w;
+        }
+    }
+    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
+}
+
+/// The forces of `particles_to_grid` alone, into `force`: f_i = sum_p (M_p b_p N_ip -
+/// V_p sigma_p grad N_ip), for integrators that update the stress after the mapping.
+pub fn nodal_forces<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    body_force: &[SVector<f64, D>],
+    force: &mut [SVector<f64, D>],
+) {
+    force.fill(SVector::zeros());
+    for p in 0..particles.len() {
+        let vs = particles.stress[p] * particles.volume(p);
+        let mb = body_force[p] * particles.mass[p];
+        for (i, w, g) in stencils.of(p) {
+            force[i] += mb * w - vs * g;
+        }
+    }
+}
+
 /// MUSL's v_i^L for the Shepard mapping: sum_p M_p v_p N_ip / m_i with this step's weights
 /// and nodal masses.
 pub fn remap_velocity<const D: usize>(

@@ -183,7 +183,9 @@ fn element_fits<'a>(
 }
 
 /// One row per run in the order of the run tables: its axis values, status and final error in
-/// the spec's field and norm (empty for a run that stopped before its final time).
+/// the spec's field and norm (empty for a run that stopped before its final time), then for
+/// each probe of that field with a reference the wiggle measures of its history: the total
+/// variation against the reference's and the overshoot past the reference's range.
 fn final_errors<'a>(
     experiment: &Experiment,
     runs: impl Iterator<Item = &'a RunSummary>,
@@ -194,20 +196,37 @@ fn final_errors<'a>(
     if runs.is_empty() {
         return None;
     }
+    let probes = compared_probes(&runs, field);
     let mut header = experiment.axes.clone();
     header.extend(["status".to_string(), format!("{norm} {field} error")]);
+    for (name, unit) in &probes {
+        header.push(format!("{name}: TV / exact TV"));
+        header.push(format!("{name}: overshoot ({unit})"));
+    }
     let rows = ordered_runs(&runs)
         .into_iter()
         .map(|run| {
             let mut row: Vec<String> = axis_values(experiment, run).collect();
             let error = run.final_norms.get(&(field.clone(), norm.clone()));
             let finished = run.status == RunStatus::Ok;
-            row.push(run.status.as_str().to_string());
-            row.push(
-                error
+            let shown = |value: Option<f64>| {
+                value
                     .filter(|_| finished)
-                    .map_or_else(String::new, |&e| general(e, 4)),
-            );
+                    .map_or_else(String::new, |e| general(e, 4))
+            };
+            row.push(run.status.as_str().to_string());
+            row.push(shown(error.copied()));
+            for (name, _) in &probes {
+                let wiggles = run
+                    .probes
+                    .iter()
+                    .find(|p| &p.name == name)
+                    .map(|p| p.wiggles());
+                row.push(shown(
+                    wiggles.map(|w| w.total_variation / w.reference_total_variation),
+                ));
+                row.push(shown(wiggles.map(|w| w.overshoot)));
+            }
             row
         })
         .collect();
@@ -219,11 +238,32 @@ fn final_errors<'a>(
         note: format!(
             "The {norm} norm of the {field} error over the particles at the final time (rms: \
              sqrt(sum_p e_p^2 / N_p), Molinos eq 40; l2: sqrt(sum_p V_p e_p^2)); NaN where the \
-             benchmark has no exact solution, empty for a run that did not finish."
+             benchmark has no exact solution, empty for a run that did not finish.{}",
+            if probes.is_empty() {
+                ""
+            } else {
+                " For each probe of the field, the total variation of its history, \
+                 sum_k |v_(k+1) - v_k| over every step, divided by the exact history's (1: no \
+                 ringing; below 1: damped), and the overshoot, how far the history goes past \
+                 the exact range (`/probes/<name>` attributes)."
+            }
         ),
         header,
         rows,
     })
+}
+
+/// The probes of `field` that have a reference, by name and unit, in the order of the first
+/// run that records each.
+fn compared_probes(runs: &[RunSummary], field: &str) -> Vec<(String, &'static str)> {
+    let mut probes: Vec<(String, &'static str)> = Vec::new();
+    for probe in runs.iter().flat_map(|run| &run.probes) {
+        let compared = probe.quantity == field && probe.reference_kind == "exact";
+        if compared && !probes.iter().any(|(name, _)| name == &probe.name) {
+            probes.push((probe.name.clone(), probe.unit()));
+        }
+    }
+    probes
 }
 
 /// Four decimals; rounding-level values as 0.

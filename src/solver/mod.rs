@@ -14,12 +14,12 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
 use crate::experiment::RunSpec;
-use crate::integrate::predictor_corrector::CarriedVelocity;
+use crate::integrate::predictor_corrector::PredictorCorrector;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
 use crate::particles::Particles;
-use crate::reconstruct::{FitStats, GridState};
+use crate::reconstruct::{nodal_forces, FitStats, GridState};
 use crate::shape::{
     Dofs, DualDomain, Grid, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape,
     Stencils,
@@ -86,12 +86,13 @@ enum Basis<const D: usize> {
     LocalMaxEnt(LocalMaxEnt<D>),
 }
 
-/// The particle-to-grid mappings of a step: the transfer at its start, and MUSL's remap of
-/// the updated particle velocities.
+/// The particle-to-grid mappings of a step: the transfer at its start, MUSL's remap of the
+/// updated particle velocities, or the predictor-corrector's mapping of v_p + dt/2 a_p.
 #[derive(Clone, Copy)]
 enum Mapping {
     Step,
     Remap,
+    Predictor,
 }
 
 impl<const D: usize> Basis<D> {
@@ -122,8 +123,9 @@ struct Run<'a, const D: usize> {
     body_force: Vec<SVector<f64, D>>,
     /// Nodal velocity rebuilt after the particles moved (MUSL and eqs 23-24 only).
     remapped: Vec<SVector<f64, D>>,
-    /// The nodal velocity the grid carries between steps (predictor-corrector only).
-    carried: Option<CarriedVelocity<D>>,
+    /// The particle accelerations and scratch of the predictor-corrector (unused by the
+    /// other integrators).
+    predictor: PredictorCorrector<D>,
     fits: FitStats,
     /// The flat index of every particle's cell, after the last move.
     cells: Vec<usize>,
@@ -171,8 +173,6 @@ impl<'a, const D: usize> Run<'a, D> {
                 (Basis::LocalMaxEnt(lme), per_point)
             }
         };
-        let carried = (method.integrator == IntegratorKind::PredictorCorrector)
-            .then(|| CarriedVelocity::new(grid.num_nodes()));
         Run {
             spec,
             method,
@@ -181,7 +181,7 @@ impl<'a, const D: usize> Run<'a, D> {
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
-            carried,
+            predictor: PredictorCorrector::new(n, grid.num_nodes()),
             grid,
             particles,
             fixed,
@@ -249,25 +249,27 @@ impl<'a, const D: usize> Run<'a, D> {
         for s in 0..=steps {
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
-            match self.transfer.map_to_grid(
-                &self.stencils,
-                &self.particles,
-                &self.body_force,
-                &mut self.nodes,
-            ) {
-                Ok(stats) => self.fits += stats,
-                Err(reason) => return (s, Err((s, reason))),
-            }
-            self.track_mapping(Mapping::Step);
             // Staggered velocities start with a half kick from v^0 to v^{1/2}.
             let staggered = self.method.integrator.staggers_velocity();
             let kick = if staggered && s == 0 { 0.5 * dt } else { dt };
-            if let Some(carried) = &self.carried {
-                carried.substitute(&mut self.nodes);
-            }
-            self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick);
-            if let Some(carried) = &mut self.carried {
-                carried.keep(&self.nodes);
+            if self.method.integrator == IntegratorKind::PredictorCorrector {
+                // The predictor-corrector solves its grid after the stress update.
+                self.predictor
+                    .predict(&self.stencils, &self.particles, dt, &mut self.nodes);
+                self.track_mapping(Mapping::Predictor);
+                integrate::apply_fixed(&mut self.nodes.velocity, &self.fixed);
+            } else {
+                match self.transfer.map_to_grid(
+                    &self.stencils,
+                    &self.particles,
+                    &self.body_force,
+                    &mut self.nodes,
+                ) {
+                    Ok(stats) => self.fits += stats,
+                    Err(reason) => return (s, Err((s, reason))),
+                }
+                self.track_mapping(Mapping::Step);
+                self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick);
             }
             self.record_probes(s, t, synchronising_half(s, dt));
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
@@ -347,14 +349,15 @@ impl<'a, const D: usize> Run<'a, D> {
 
     /// Records how far the totals the last mapping gave the DOFs are from the particles'.
     fn track_mapping(&mut self, mapping: Mapping) {
-        let velocity = match mapping {
-            Mapping::Step => &self.nodes.velocity,
-            Mapping::Remap => &self.remapped,
+        let (velocity, sent) = match mapping {
+            Mapping::Step => (&self.nodes.velocity, self.particles.v.as_slice()),
+            Mapping::Remap => (&self.remapped, self.particles.v.as_slice()),
+            Mapping::Predictor => (&self.nodes.velocity, self.predictor.predicted()),
         };
         let grid_mass = self.nodes.mass.iter().sum();
         let momentum = self.transfer.received_momentum(&self.nodes.mass, velocity);
         self.recorder
-            .track_mapping(&self.particles, grid_mass, &momentum);
+            .track_mapping(&self.particles.mass, sent, grid_mass, &momentum);
     }
 
     /// The shape functions of every particle at its current position and domain.
@@ -390,19 +393,16 @@ impl<'a, const D: usize> Run<'a, D> {
     /// Step 3 of the method's integrator, after the grid solve.
     fn update_particles(&mut self, kick: f64, dt: f64) -> Result<(), Divergence> {
         let material = self.problem.material();
-        let integrator = self.method.integrator;
-        let drift = if integrator.drifts_with_start_velocity() {
-            &self.nodes.velocity
-        } else {
-            &self.nodes.velocity_new
+        let drift = match self.method.integrator {
+            IntegratorKind::PredictorCorrector => return self.correct_and_move(dt),
+            IntegratorKind::Euler | IntegratorKind::EulerCorrected => &self.nodes.velocity,
+            IntegratorKind::Leapfrog | IntegratorKind::Musl => &self.nodes.velocity_new,
         };
         if let Basis::Domains(domains) = &mut self.basis {
             domains.advance_corners(&self.grid, drift, dt)?;
         }
-        match integrator {
-            IntegratorKind::Leapfrog
-            | IntegratorKind::PredictorCorrector
-            | IntegratorKind::Euler => leapfrog::update_particles(
+        if !self.method.integrator.remaps_velocity() {
+            return leapfrog::update_particles(
                 &self.stencils,
                 &mut self.particles,
                 &self.nodes,
@@ -410,30 +410,43 @@ impl<'a, const D: usize> Run<'a, D> {
                 kick,
                 dt,
                 &material,
-            ),
-            IntegratorKind::Musl | IntegratorKind::EulerCorrected => {
-                musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, drift, dt)?;
-                self.transfer.remap_velocity(
-                    &self.stencils,
-                    &self.particles,
-                    &self.nodes,
-                    &mut self.remapped,
-                );
-                self.track_mapping(Mapping::Remap);
-                integrate::apply_fixed(&mut self.remapped, &self.fixed);
-                musl::deform_particles(
-                    &self.stencils,
-                    &mut self.particles,
-                    &self.remapped,
-                    dt,
-                    &material,
-                )
-            }
+            );
         }
+        musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, drift, dt)?;
+        self.transfer.remap_velocity(
+            &self.stencils,
+            &self.particles,
+            &self.nodes,
+            &mut self.remapped,
+        );
+        self.track_mapping(Mapping::Remap);
+        integrate::apply_fixed(&mut self.remapped, &self.fixed);
+        integrate::deform_particles(
+            &self.stencils,
+            &mut self.particles,
+            &self.remapped,
+            dt,
+            &material,
+        )
+    }
+
+    /// Steps 2-5 of `integrate::predictor_corrector` after its predictor, at the
+    /// start-of-step positions: the stress from v~, the forces, the corrector, the move.
+    fn correct_and_move(&mut self, dt: f64) -> Result<(), Divergence> {
+        let material = self.problem.material();
+        let (stencils, particles, nodes) = (&self.stencils, &mut self.particles, &mut self.nodes);
+        integrate::deform_particles(stencils, particles, &nodes.velocity, dt, &material)?;
+        nodal_forces(stencils, particles, &self.body_force, &mut nodes.force);
+        let drift = self.predictor.correct(nodes, &self.fixed, dt);
+        if let Basis::Domains(domains) = &mut self.basis {
+            domains.advance_corners(&self.grid, drift, dt)?;
+        }
+        self.predictor
+            .move_particles(stencils, particles, nodes, dt)
     }
 }
 
-/// What a staggered integrator (leapfrog, predictor-corrector) adds to the half-step velocity to synchronise it at step `s`: a^s dt / 2,
+/// What the leapfrog adds to the half-step velocity to synchronise it at step `s`: a^s dt / 2,
 /// or nothing at s = 0 where the particles still carry v^0.
 fn synchronising_half(s: usize, dt: f64) -> f64 {
     if s == 0 {

@@ -123,14 +123,15 @@ impl Recorder {
     /// from and keeps the largest relative errors of the run.
     pub fn track_mapping<const D: usize>(
         &mut self,
-        particles: &Particles<D>,
+        particle_mass: &[f64],
+        particle_velocity: &[SVector<f64, D>],
         grid_mass: f64,
         grid_momentum: &SVector<f64, D>,
     ) {
         let mut mass = 0.0;
         let mut momentum = SVector::<f64, D>::zeros();
         let mut scale = 0.0;
-        for (m, v) in particles.mass.iter().zip(&particles.v) {
+        for (m, v) in particle_mass.iter().zip(particle_velocity) {
             mass += m;
             momentum += v * *m;
             scale += m * v.norm();

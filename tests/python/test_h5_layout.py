@@ -1298,7 +1298,7 @@ PROBE_UNITS = {"displacement": "m", "velocity": "m/s", "stress": "Pa"}
 PROBE_REFERENCES = ("exact", "static", "none")
 # Benchmarks whose simulation runs must record these probes.
 PROBED = {
-    "dyka_bar": ("free_end_velocity", "mid_stress"),
+    "dyka_bar": ("free_end_velocity", "mid_stress", "quarter_stress"),
     "andersen_block": ("bottom_stress", "top_displacement"),
 }
 
@@ -1380,6 +1380,27 @@ def test_probes_match_the_history(run):
         expected = _probe_quantity(run, name)[keep]
         np.testing.assert_array_equal(run.ds(f"{base}/value")[at[keep]], expected,
                                       err_msg=f"{base}/value against /history")
+
+
+def test_probe_wiggle_measures(run):
+    """The total variations and the overshoot of /probes/<name> recomputed from its data."""
+    _require_probes(run)
+    for name in _probes(run):
+        base = f"/probes/{name}"
+        g = run.group(base)
+        value, reference = run.ds(f"{base}/value"), run.ds(f"{base}/reference")
+        tv = np.sum(np.abs(np.diff(value)))
+        np.testing.assert_allclose(g["total_variation"], tv, rtol=1e-12, atol=0,
+                                   err_msg=f"{base}: total_variation")
+        if g["reference"] == "none":
+            assert np.isnan(g["reference_total_variation"]) and np.isnan(g["overshoot"])
+            continue
+        np.testing.assert_allclose(g["reference_total_variation"],
+                                   np.sum(np.abs(np.diff(reference))), rtol=1e-12, atol=0,
+                                   err_msg=f"{base}: reference_total_variation")
+        past = max(value.max() - reference.max(), reference.min() - value.min(), 0.0)
+        np.testing.assert_allclose(g["overshoot"], past, rtol=1e-12, atol=0,
+                                   err_msg=f"{base}: overshoot")
 
 
 def dyka_reference(run, x, t, quantity):
