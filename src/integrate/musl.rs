@@ -13,14 +13,16 @@ use crate::reconstruct::GridState;
 use crate::shape::Stencils;
 
 /// Eqs 34-35: v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the nodal velocity
-/// `drift`: v_i^{t+1} (`grid.velocity_new`, MUSL), or the start-of-step v_i^t
-/// (`grid.velocity`, Molinos et al. eq 23).
+/// `drift`: v_i^{t+1} (`grid.velocity_new`, MUSL), the start-of-step v_i^t (`grid.velocity`,
+/// Molinos et al. eq 23) or the predictor-corrector's v_i + dt/2 a_i. `acceleration`, when
+/// given, receives every a_p = sum_i N_ip a_i.
 pub fn move_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
     grid: &GridState<D>,
     drift: &[SVector<f64, D>],
     dt: f64,
+    mut acceleration: Option<&mut [SVector<f64, D>]>,
 ) -> Result<(), Divergence> {
     for p in 0..particles.len() {
         let mut a = SVector::<f64, D>::zeros();
@@ -34,6 +36,9 @@ pub fn move_particles<const D: usize>(
                 particle: p,
                 what: "velocity",
             });
+        }
+        if let Some(out) = acceleration.as_deref_mut() {
+            out[p] = a;
         }
         particles.v[p] += a * dt;
         particles.x[p] += v * dt;

@@ -16,6 +16,7 @@
 
 use nalgebra::SVector;
 
+use super::musl::move_particles;
 use super::{solve_grid, Divergence, FixedDof};
 use crate::particles::Particles;
 use crate::reconstruct::{map_velocity, GridState};
@@ -87,7 +88,8 @@ impl<const D: usize> PredictorCorrector<D> {
         &self.drift
     }
 
-    /// Step 5: a_p = sum_i N_ip a_i, v_p += dt a_p, x_p += dt sum_i N_ip (v_i + dt/2 a_i).
+    /// Step 5: a_p = sum_i N_ip a_i, v_p += dt a_p, x_p += dt sum_i N_ip (v_i + dt/2 a_i);
+    /// a_p is kept for the next predictor.
     pub fn move_particles(
         &mut self,
         stencils: &Stencils<D>,
@@ -95,24 +97,8 @@ impl<const D: usize> PredictorCorrector<D> {
         grid: &GridState<D>,
         dt: f64,
     ) -> Result<(), Divergence> {
-        for p in 0..particles.len() {
-            let mut a = SVector::<f64, D>::zeros();
-            let mut v = SVector::<f64, D>::zeros();
-            for (i, w, _) in stencils.of(p) {
-                a += grid.force[i] * w;
-                v += self.drift[i] * w;
-            }
-            if !a.iter().chain(v.iter()).all(|c| c.is_finite()) {
-                return Err(Divergence::NonFinite {
-                    particle: p,
-                    what: "velocity",
-                });
-            }
-            self.acceleration[p] = a;
-            particles.v[p] += a * dt;
-            particles.x[p] += v * dt;
-        }
-        Ok(())
+        let acceleration = Some(self.acceleration.as_mut_slice());
+        move_particles(stencils, particles, grid, &self.drift, dt, acceleration)
     }
 }
 

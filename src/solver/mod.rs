@@ -412,7 +412,14 @@ impl<'a, const D: usize> Run<'a, D> {
                 &material,
             );
         }
-        musl::move_particles(&self.stencils, &mut self.particles, &self.nodes, drift, dt)?;
+        musl::move_particles(
+            &self.stencils,
+            &mut self.particles,
+            &self.nodes,
+            drift,
+            dt,
+            None,
+        )?;
         self.transfer.remap_velocity(
             &self.stencils,
             &self.particles,
