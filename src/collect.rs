@@ -63,8 +63,8 @@ fn wants_profiles(experiment: &Experiment) -> bool {
             .any(|f| f.kind == FigureKind::Profile)
 }
 
-/// Whether the report needs the `/probes` of every run: to draw their histories, or for the
-/// wiggle measures of its errors tables.
+/// Whether the report needs the `/probes` of every run: to draw their histories, for the
+/// wiggle measures of its errors tables, or for its probes tables.
 fn reads_probes(experiment: &Experiment) -> bool {
     experiment
         .figures
@@ -73,5 +73,5 @@ fn reads_probes(experiment: &Experiment) -> bool {
         || experiment
             .tables
             .iter()
-            .any(|t| t.kind == TableKind::Errors)
+            .any(|t| matches!(t.kind, TableKind::Errors | TableKind::Probes))
 }

@@ -1321,6 +1321,60 @@ fn an_errors_table_needs_a_known_field() {
 }
 
 #[test]
+fn probes_tables_are_read_with_their_window() {
+    let text = MOLINOS.replace(
+        "  - {kind: errors, field: velocity, norm: rms}",
+        "  - {kind: probes, probe: top_displacement, after: 10.0, tolerance: 0.05}",
+    );
+    let exp = parse(&text).unwrap();
+    let window = exp.tables[0].probe.as_ref().unwrap();
+    assert_eq!(window.name, "top_displacement");
+    assert_eq!((window.after, window.tolerance), (10.0, 0.05));
+    let text = MOLINOS.replace(
+        "  - {kind: errors, field: velocity, norm: rms}",
+        "  - {kind: probes, probe: top_displacement, tolerance: 0.05}",
+    );
+    assert_eq!(
+        parse(&text).unwrap().tables[0]
+            .probe
+            .as_ref()
+            .unwrap()
+            .after,
+        0.0
+    );
+}
+
+#[test]
+fn a_probes_table_needs_a_probe_and_a_positive_tolerance() {
+    let table =
+        |entry: &str| MOLINOS.replace("  - {kind: errors, field: velocity, norm: rms}", entry);
+    let text = table("  - {kind: probes, tolerance: 0.05}");
+    check(
+        &error(&text),
+        10,
+        5,
+        "tables[0].probe",
+        "needs 'probe'",
+        &[],
+    );
+    let text = table("  - {kind: probes, probe: top_displacement}");
+    check(
+        &error(&text),
+        10,
+        5,
+        "tables[0].tolerance",
+        "needs 'tolerance'",
+        &[],
+    );
+    let text = table("  - {kind: probes, probe: top_displacement, tolerance: -1.0}");
+    check(&error(&text), 10, 56, "tables[0].tolerance", "> 0", &[]);
+    let text =
+        table("  - {kind: probes, probe: top_displacement, tolerance: 1.0, field: velocity}");
+    let e = error(&text);
+    assert_eq!(e.field, "tables[0].field", "{e}");
+}
+
+#[test]
 fn gauss_placement_is_refused_with_particle_domains() {
     let text = MOLINOS.replace("placement: [centres]", "placement: [gauss]");
     check(

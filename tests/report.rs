@@ -5,7 +5,9 @@ use std::fs;
 use std::path::Path;
 
 use mpmlab::benchmarks::BenchmarkKind;
-use mpmlab::experiment::{Expectation, Experiment, FigureKind, FigureSpec, OutputSpec};
+use mpmlab::experiment::{
+    Expectation, Experiment, FigureKind, FigureSpec, OutputSpec, ProbeWindow, TableKind, TableSpec,
+};
 use mpmlab::output::{ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
 use mpmlab::report::{check, fit_rates, write_report, CheckFailure};
@@ -451,6 +453,50 @@ fn history_figures_draw_every_run_and_name_unknown_probes() {
     let exp = experiment(vec![], vec![history("root")]);
     let error = write_report(dir.path(), &exp, &runs, &[], None).unwrap_err();
     let message = error.to_string();
+    assert!(message.contains("probe 'root'"), "{message}");
+    assert!(message.contains("the runs record: tip"), "{message}");
+}
+
+fn probes_table(probe: &str) -> TableSpec {
+    TableSpec {
+        kind: TableKind::Probes,
+        columns: None,
+        select: Params::new(),
+        stability: None,
+        measure: None,
+        probe: Some(ProbeWindow {
+            name: probe.into(),
+            after: 0.5,
+            tolerance: 0.3,
+        }),
+    }
+}
+
+/// The probe `tip` is t against its reference 2t. Over t >= 0.5 the finished run has six
+/// points, t = 0.5 ... 1.0: mean 0.75, sd sqrt(0.175 / 6), reference 2 at the end, distance t
+/// at most 1, farther than 0.3 from the first point on; the diverged run stopped at t = 0.5.
+#[test]
+fn probes_tables_list_every_run_and_name_unknown_probes() {
+    let runs = vec![
+        probed("mpm", RunStatus::Ok),
+        probed("usl", RunStatus::Diverged),
+    ];
+    let mut exp = experiment(vec![], vec![]);
+    exp.tables = vec![probes_table("tip")];
+    let dir = tempfile::tempdir().unwrap();
+    write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    let md = read(dir.path(), "report.md");
+    assert!(md.contains("### Probe tip after t = 0.5"), "{md}");
+    assert!(md.contains("| ok | 0.75 | 0.1708 | 2 | 1 | 0.5 |"), "{md}");
+    assert!(
+        md.contains("| diverged | 0.5 | 0 | 1 | 0.5 | 0.5 |"),
+        "{md}"
+    );
+
+    exp.tables = vec![probes_table("root")];
+    let message = write_report(dir.path(), &exp, &runs, &[], None)
+        .unwrap_err()
+        .to_string();
     assert!(message.contains("probe 'root'"), "{message}");
     assert!(message.contains("the runs record: tip"), "{message}");
 }

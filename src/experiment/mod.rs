@@ -232,6 +232,9 @@ pub enum TableKind {
     /// One row per run: its axis values and its final error in one field and norm (Molinos
     /// eq 40 with velocity and rms).
     Errors,
+    /// One row per run: how a probe's history settles against its reference after a time
+    /// (Molinos Figs 10-11: which runs stay stable, when the others leave).
+    Probes,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -245,4 +248,18 @@ pub struct TableSpec {
     pub stability: Option<StabilityAxes>,
     /// Errors tables only: the (field, norm) listed.
     pub measure: Option<(String, String)>,
+    /// Probes tables only: the probe and the window it is judged over.
+    pub probe: Option<ProbeWindow>,
+}
+
+/// What a probes table reads of a probe's history.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeWindow {
+    /// The probe's name (checked against the run files by the report).
+    pub name: String,
+    /// The statistics are taken over t >= after (s).
+    pub after: f64,
+    /// A run has left its reference at the first t >= after with |value - reference| above
+    /// this (in the probe's unit).
+    pub tolerance: f64,
 }

@@ -12,8 +12,9 @@ use super::measures::{error_field, norm};
 use super::select::axis_key;
 use super::space::ParamSpace;
 use super::stability;
-use super::yaml::{child_field, find, Entry};
-use super::{TableKind, TableSpec};
+use super::values::{finite, positive};
+use super::yaml::{child_field, find, Entry, Node};
+use super::{ProbeWindow, TableKind, TableSpec};
 
 const KINDS: Kinds<TableKind> = Kinds {
     what: "table",
@@ -23,8 +24,19 @@ const KINDS: Kinds<TableKind> = Kinds {
         ("stability", TableKind::Stability),
         ("element_fits", TableKind::ElementFits),
         ("errors", TableKind::Errors),
+        ("probes", TableKind::Probes),
     ],
-    keys: &["kind", "columns", "x", "sweep", "field", "norm"],
+    keys: &[
+        "kind",
+        "columns",
+        "x",
+        "sweep",
+        "field",
+        "norm",
+        "probe",
+        "after",
+        "tolerance",
+    ],
     takes,
     suits: lists_for,
 };
@@ -89,12 +101,47 @@ fn table(
         }
         _ => None,
     };
+    let probe = match kind {
+        TableKind::Probes => Some(probe_window(&entries, node, parent)?),
+        _ => None,
+    };
     Ok(TableSpec {
         kind: kind.clone(),
         columns,
         select,
         stability,
         measure,
+        probe,
+    })
+}
+
+/// `probe` and `tolerance` (> 0) are required; `after` is a finite time, 0 when left out.
+fn probe_window(entries: &[Entry], node: &Node, parent: &str) -> Result<ProbeWindow, ConfigError> {
+    let required = |key: &str, what: &str| {
+        find(entries, key).ok_or_else(|| {
+            ConfigError::at(
+                node.pos,
+                child_field(parent, key),
+                format!("a probes table needs '{key}': {what}"),
+            )
+        })
+    };
+    let name = required("probe", "the name of a probe its runs record")?;
+    let tolerance = required(
+        "tolerance",
+        "how far from its reference the probe may go before the run counts as having left it",
+    )?;
+    let after = match find(entries, "after") {
+        Some(e) => finite(e.value, &child_field(parent, "after"))?,
+        None => 0.0,
+    };
+    Ok(ProbeWindow {
+        name: name
+            .value
+            .as_text(&child_field(parent, "probe"))?
+            .to_string(),
+        after,
+        tolerance: positive(tolerance.value, &child_field(parent, "tolerance"))?,
     })
 }
 
@@ -105,6 +152,7 @@ fn takes(kind: &TableKind) -> &'static [&'static str] {
         TableKind::BasisNorms | TableKind::ElementFits => &[],
         TableKind::Stability => &["x", "sweep"],
         TableKind::Errors => &["field", "norm"],
+        TableKind::Probes => &["probe", "after", "tolerance"],
     }
 }
 
@@ -119,5 +167,6 @@ fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
         TableKind::Stability => benchmark == BenchmarkKind::Simulation,
         TableKind::ElementFits => benchmark == BenchmarkKind::Elementwise,
         TableKind::Errors => true,
+        TableKind::Probes => benchmark == BenchmarkKind::Simulation,
     }
 }

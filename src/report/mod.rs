@@ -12,6 +12,7 @@ mod group;
 mod markdown;
 mod plot;
 mod pointwise;
+mod probe_table;
 pub mod stability;
 mod tables;
 
@@ -62,6 +63,7 @@ pub fn write_report(
     check: Option<&[CheckFailure]>,
 ) -> io::Result<Report> {
     let figures = figures::plan(experiment, runs).map_err(io::Error::other)?;
+    let tables = pointwise::tables(experiment, runs).map_err(io::Error::other)?;
     let figure_dir = dir.join("figures");
     fs::create_dir_all(&figure_dir)?;
     remove_stale_figures(&figure_dir, &figures)?;
@@ -73,7 +75,6 @@ pub fn write_report(
     for figure in &figures {
         plot::render(&dir.join(&figure.file), figure)?;
     }
-    let tables = pointwise::tables(experiment, runs);
     let md = markdown::report_md(experiment, runs, rates, &tables, &figures, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report {

@@ -6,6 +6,7 @@
 
 use super::format::general;
 use super::group::{axis_values, group_runs, label, ordered_runs, selects, title_suffix};
+use super::probe_table;
 use super::stability;
 use crate::experiment::{Experiment, TableKind, TableSpec};
 use crate::output::{ElementRecord, ReconstructionRecord, RunStatus, RunSummary};
@@ -19,8 +20,9 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
-/// Every table the experiment's `tables` entries ask for, in their order.
-pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
+/// Every table the experiment's `tables` entries ask for, in their order; an error names a
+/// probe no selected run records.
+pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Table>, String> {
     let mut tables = Vec::new();
     for spec in &experiment.tables {
         let selected = runs.iter().filter(|run| selects(&spec.select, &run.axes));
@@ -30,9 +32,10 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Vec<Table> {
             TableKind::Stability => tables.extend(stability::tables(selected, spec)),
             TableKind::ElementFits => tables.extend(element_fits(experiment, selected)),
             TableKind::Errors => tables.extend(final_errors(experiment, selected, spec)),
+            TableKind::Probes => tables.extend(probe_table::table(experiment, selected, spec)?),
         }
     }
-    tables
+    Ok(tables)
 }
 
 /// One table per group of the axes other than `columns`; a column per run of the group, in
