@@ -4,9 +4,10 @@
 use std::fmt;
 
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
-use crate::params::{get_f64, get_str, ParamError, Params};
+use crate::params::{get_f64, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{
-    Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe, Weight,
+    BodyForceFit, Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe,
+    Weight,
 };
 use crate::shape::{DomainShape, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
 
@@ -60,6 +61,10 @@ pub enum IntegratorKind {
     /// Whole-step velocities, particles moved first, velocity gradient from the nodal
     /// velocity rebuilt from the moved particles (Tran eqs 31-40; Sulsky's MUSL).
     Musl,
+    /// Whole-step velocities, particles kicked and moved with the updated nodal velocity and
+    /// deformed with it (update stress last, no remap): what the CPLS code of Tran et al.
+    /// runs for MPM, CPDI and IMLS-MPM.
+    Usl,
     /// Sulsky et al. 1994 as Molinos et al. eqs 21-22 write it: whole-step velocities,
     /// v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the start-of-step nodal
     /// velocity, the stress from the updated nodal velocity v_i + dt a_i.
@@ -80,13 +85,15 @@ impl IntegratorKind {
     pub const NAMES: &'static [&'static str] = &[
         "leapfrog",
         "musl",
+        "usl",
         "euler",
         "euler_corrected",
         "predictor_corrector",
     ];
-    const ALL: [IntegratorKind; 5] = [
+    const ALL: [IntegratorKind; 6] = [
         IntegratorKind::Leapfrog,
         IntegratorKind::Musl,
+        IntegratorKind::Usl,
         IntegratorKind::Euler,
         IntegratorKind::EulerCorrected,
         IntegratorKind::PredictorCorrector,
@@ -96,9 +103,10 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Leapfrog => Self::NAMES[0],
             IntegratorKind::Musl => Self::NAMES[1],
-            IntegratorKind::Euler => Self::NAMES[2],
-            IntegratorKind::EulerCorrected => Self::NAMES[3],
-            IntegratorKind::PredictorCorrector => Self::NAMES[4],
+            IntegratorKind::Usl => Self::NAMES[2],
+            IntegratorKind::Euler => Self::NAMES[3],
+            IntegratorKind::EulerCorrected => Self::NAMES[4],
+            IntegratorKind::PredictorCorrector => Self::NAMES[5],
         }
     }
 
@@ -154,6 +162,7 @@ const IMPM: QuadratureRecipe = QuadratureRecipe {
     velocity: recipe(Weight::CubicSpline, 1.0, Solver::Mls),
     fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Mls),
     gauss_points: 1,
+    body_force: BodyForceFit::Separate,
 };
 
 /// Tran eqs 24-31: velocity by IMLS with the hat weight, density, stress and body force by
@@ -164,6 +173,16 @@ const IMLS: QuadratureRecipe = QuadratureRecipe {
     velocity: recipe(Weight::Hat, 1.0, Solver::Imls),
     fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Imls),
     gauss_points: 2,
+    body_force: BodyForceFit::Separate,
+};
+
+/// IMLS-MPM as the CPLS code of Tran et al. runs it (`Compute_Interpolator_IMLS_MPM`,
+/// `Interpolate_Particle_To_Grid_MLS`): the fields at the cell centre (one point per cell),
+/// the body force as one fit of rho_p b_p.
+const IMLS_CPLS: QuadratureRecipe = QuadratureRecipe {
+    gauss_points: 1,
+    body_force: BodyForceFit::Product,
+    ..IMLS
 };
 
 const IMLS_EQ27: QuadratureRecipe = QuadratureRecipe {
@@ -245,6 +264,17 @@ const PRESETS: &[MethodPreset] = &[
         },
         source: "Tran, Berzins, Solowski 2019",
         description: "IMLS-MPM: IMLS velocity at nodes, IMLS fields at 2 Gauss points, MUSL",
+    },
+    MethodPreset {
+        name: "imls_cpls",
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::Quadrature(IMLS_CPLS),
+            integrator: IntegratorKind::Usl,
+        },
+        source: "Tran, Berzins, Solowski 2019, as their CPLS code runs it (IMLS_MPM_solver.m)",
+        description:
+            "IMLS-MPM: IMLS velocity at nodes, IMLS fields and rho b at the cell centre, USL",
     },
     MethodPreset {
         name: "imls_eq27",
@@ -389,6 +419,8 @@ pub fn preset_names() -> Vec<&'static str> {
 pub const GAMMA_KEY: &str = "gamma";
 pub const LME_TOLERANCE_KEY: &str = "lme_tolerance";
 pub const INTEGRATOR_KEY: &str = "integrator";
+pub const GAUSS_POINTS_KEY: &str = "gauss_points";
+pub const BODY_FORCE_FIT_KEY: &str = "body_force_fit";
 
 /// Parameters of the method rather than the benchmark, settable in `params` or as matrix axes
 /// of any simulation. They have no defaults that enter a run: a run that does not set them has
@@ -413,13 +445,30 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Choice(IntegratorKind::NAMES),
         default: ParamDefault::Text("the preset's"),
         unit: "",
-        doc: "time integrator in place of the preset's (Shepard-transfer methods only)",
+        doc: "time integrator in place of the preset's (not for the TLS transfers, which solve \
+              their own grid; predictor_corrector with the Shepard transfer only)",
+    },
+    ParamSpec {
+        key: GAUSS_POINTS_KEY,
+        kind: ParamKind::PositiveInt,
+        default: ParamDefault::Text("the preset's"),
+        unit: "1",
+        doc: "Gauss points per cell and axis of the field fits (quadrature transfers: impm, imls)",
+    },
+    ParamSpec {
+        key: BODY_FORCE_FIT_KEY,
+        kind: ParamKind::Choice(BodyForceFit::NAMES),
+        default: ParamDefault::Text("the preset's"),
+        unit: "",
+        doc: "separate: rho and b fitted apart; product: one fit of rho_p b_p (quadrature \
+              transfers only)",
     },
 ];
 
 /// The method a run uses: the preset, its integrator replaced by the run's `integrator`, its
-/// LME basis given the run's gamma and cut-off. Checks that the run's method parameters apply
-/// to the preset and are valid in `dim` dimensions.
+/// LME basis given the run's gamma and cut-off, its quadrature transfer given the run's Gauss
+/// points and body-force fit. Checks that the run's method parameters apply to the preset and
+/// are valid in `dim` dimensions.
 pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Method, ParamError> {
     let mut method = preset.method;
     if let ShapeKind::LocalMaxEnt(lme) = &mut method.shape {
@@ -466,21 +515,73 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
                 ),
             )
         })?;
-        if integrator != preset.method.integrator && method.transfer != TransferKind::Shepard {
-            return Err(ParamError::new(
-                INTEGRATOR_KEY,
-                format!(
-                    "{} maps with {}, whose grid solve belongs to its own integrator; the \
-                     integrator can be replaced for the methods with the Shepard transfer: {}",
-                    preset.name,
-                    method.transfer,
-                    preset_names_where(|m| m.transfer == TransferKind::Shepard).join(", ")
-                ),
-            ));
+        if integrator != preset.method.integrator {
+            check_integrator(preset, integrator)?;
         }
         method.integrator = integrator;
     }
+    if let TransferKind::Quadrature(recipe) = &mut method.transfer {
+        if params.contains_key(GAUSS_POINTS_KEY) {
+            recipe.gauss_points = get_usize(params, GAUSS_POINTS_KEY)?;
+        }
+        if params.contains_key(BODY_FORCE_FIT_KEY) {
+            let name = get_str(params, BODY_FORCE_FIT_KEY)?;
+            recipe.body_force = BodyForceFit::from_name(name).ok_or_else(|| {
+                ParamError::new(
+                    BODY_FORCE_FIT_KEY,
+                    format!(
+                        "unknown body_force_fit '{name}'; valid: {}",
+                        BodyForceFit::NAMES.join(", ")
+                    ),
+                )
+            })?;
+        }
+    } else {
+        for key in [GAUSS_POINTS_KEY, BODY_FORCE_FIT_KEY] {
+            if params.contains_key(key) {
+                return Err(ParamError::new(
+                    key,
+                    format!(
+                        "{key} applies to the quadrature transfers only ({}), not to {}",
+                        preset_names_where(|m| matches!(m.transfer, TransferKind::Quadrature(_)))
+                            .join(", "),
+                        preset.name
+                    ),
+                ));
+            }
+        }
+    }
     Ok(method)
+}
+
+/// Refuses an `integrator` the preset's transfer cannot run, naming the presets that can.
+fn check_integrator(preset: &MethodPreset, integrator: IntegratorKind) -> Result<(), ParamError> {
+    if runs_with(&preset.method, integrator) {
+        return Ok(());
+    }
+    Err(ParamError::new(
+        INTEGRATOR_KEY,
+        format!(
+            "{} maps with {}, which cannot run {integrator}; {integrator} runs with the methods \
+             {}",
+            preset.name,
+            preset.method.transfer,
+            preset_names_where(|m| runs_with(m, integrator)).join(", ")
+        ),
+    ))
+}
+
+/// Whether `method`'s transfer can run `integrator`: the TLS transfers solve the grid with
+/// their own mass matrix, so they keep their integrator; the predictor-corrector maps its
+/// predictor with the Shepard transfer.
+fn runs_with(method: &Method, integrator: IntegratorKind) -> bool {
+    match method.transfer {
+        TransferKind::Taylor(_) => integrator == method.integrator,
+        TransferKind::Shepard => true,
+        TransferKind::Quadrature(_) | TransferKind::FittedVelocity(_) => {
+            integrator != IntegratorKind::PredictorCorrector
+        }
+    }
 }
 
 fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {

@@ -1240,11 +1240,13 @@ fn integrator_must_be_known_and_fit_the_transfer() {
         &[
             "leapfrog",
             "musl",
+            "usl",
             "euler",
             "euler_corrected",
             "predictor_corrector",
         ],
     );
+    // The TLS transfers keep their own integrator.
     let e = error(&LME.replace("{method: [mpm],", "{method: [mpm_tls],"));
     check(
         &e,
@@ -1255,8 +1257,69 @@ fn integrator_must_be_known_and_fit_the_transfer() {
         &[],
     );
     assert!(
-        e.message.contains("Shepard transfer: mpm, mpm_musl,"),
+        e.message
+            .contains("leapfrog runs with the methods mpm, mpm_musl, impm,"),
         "{e}"
+    );
+    assert!(!e.message.contains(", mpm_tls"), "{e}");
+    // A quadrature transfer runs any integrator but the predictor-corrector, which maps its
+    // predictor with the Shepard transfer.
+    let text = LME.replace("{method: [mpm],", "{method: [imls],");
+    let e = error(&text);
+    check(
+        &e,
+        5,
+        45,
+        "matrix[0].integrator[1]",
+        "cannot run predictor_corrector",
+        &[],
+    );
+    assert!(
+        e.message
+            .contains("runs with the methods mpm, mpm_musl, ugimp,"),
+        "{e}"
+    );
+    assert!(!e.message.contains("mpm_musl, impm"), "{e}");
+    parse(&text.replace(
+        "integrator: [leapfrog, predictor_corrector]",
+        "integrator: [leapfrog, usl]",
+    ))
+    .unwrap();
+}
+
+#[test]
+fn quadrature_parameters_apply_to_quadrature_transfers_only() {
+    let text = "\
+name: exp
+benchmark: mms1d_tran
+params: {ppc: 3, dt: 1.0e-5, t_end: 0.02}
+matrix:
+  - {method: [imls], gauss_points: [1, 2], body_force_fit: [separate, product], cells: [8]}
+  - {method: [mpm], cells: [8]}
+";
+    assert_eq!(parse(text).unwrap().runs.len(), 5);
+    let e = error(&text.replace(
+        "{method: [mpm], cells",
+        "{method: [mpm], gauss_points: [1], cells",
+    ));
+    check(
+        &e,
+        6,
+        36,
+        "matrix[1].gauss_points[0]",
+        "quadrature transfers only (impm, imls,",
+        &[],
+    );
+    let e = error(&text.replace("gauss_points: [1, 2]", "gauss_points: [0, 2]"));
+    check(&e, 5, 37, "matrix[0].gauss_points[0]", "integer >= 1", &[]);
+    let e = error(&text.replace("[separate, product]", "[separate, sum]"));
+    check(
+        &e,
+        5,
+        71,
+        "matrix[0].body_force_fit[1]",
+        "sum",
+        &["separate", "product"],
     );
 }
 

@@ -319,7 +319,7 @@ fn report_files_are_written_and_deterministic() {
         "| G=0.1 method=usl | stress | l2 | 1.00 | 1.000 | 4 | 0.015625 to 0.125 |",
         "## Diverged and failed runs",
         "NaN in stress at step 120, \"J < 0\"",
-        "![gong_conv: G=0.1 method=mpm](figures/gong_conv_G_0.1_method_mpm_l2.png)",
+        "![gong_conv: displacement, velocity, stress, density (l2 norm): G=0.1 method=mpm](figures/gong_conv_G_0.1_method_mpm_l2.png)",
         "- **pass** line 10: method=mpm velocity l2: rate >= 1.8",
         "- **FAIL** line 12: method=usl stress l2: rate >= 1.8",
         "  - G=0.1 method=usl stress l2: rate 1 < rate_min 1.8",

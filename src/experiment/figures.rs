@@ -94,7 +94,7 @@ fn figure(
     })
 }
 
-/// The axis of `by`, or for a history figure also a list of axes.
+/// The axis of `by`, or for a history or convergence figure also a list of axes.
 fn by_axes(
     node: &Node,
     field: &str,
@@ -104,8 +104,11 @@ fn by_axes(
     let NodeKind::List(items) = &node.kind else {
         return Ok(vec![axis_key(node, field, space)?]);
     };
-    if *kind != FigureKind::History {
-        return Err(node.expected(field, "one matrix axis (a list applies to history figures)"));
+    if !matches!(kind, FigureKind::History | FigureKind::Convergence) {
+        return Err(node.expected(
+            field,
+            "one matrix axis (a list applies to history and convergence figures)",
+        ));
     }
     if items.is_empty() {
         return Err(node.expected(field, "a matrix axis or a non-empty list of them"));

@@ -27,7 +27,13 @@ pub(super) fn figures(
                 return None;
             }
             let which = label_or_all(&group.label);
-            let title = format!("{}{}", experiment.name, title_suffix(&group.label));
+            let title = format!(
+                "{}: {} ({} norm){}",
+                experiment.name,
+                spec.fields.join(", "),
+                spec.norm,
+                title_suffix(&group.label)
+            );
             Some(Figure {
                 file: names.file(experiment, &format!("{which}_{}", spec.norm)),
                 title,
@@ -40,17 +46,18 @@ pub(super) fn figures(
         .collect()
 }
 
-/// One curve per value of `by` (if any) and field, in that order: the runs as markers and
-/// the fit dashed between the coarsest and finest h; empty curves are dropped.
+/// One curve per combination of the `by` axes (if any) and field, in that order: the runs as
+/// markers and the fit dashed between the coarsest and finest h; empty curves are dropped.
+/// The label names the `by` axes a run sets.
 fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
     let mut curves = Vec::new();
     // Within one figure only `by` is left to vary besides the refinement axis.
     for sub in group_runs(runs.iter().copied(), &[REFINEMENT_AXIS]) {
-        let by = spec
+        let by: String = spec
             .by
-            .first()
-            .and_then(|axis| sub.axes.get(axis).map(|value| format!(", {axis}={value}")))
-            .unwrap_or_default();
+            .iter()
+            .filter_map(|axis| sub.axes.get(axis).map(|value| format!(", {axis}={value}")))
+            .collect();
         for field in &spec.fields {
             let points = usable_points(&sub.runs, field, &spec.norm);
             if points.is_empty() {
