@@ -64,6 +64,8 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         elements: None,
         shape_functions: None,
         velocity_history: None,
+        max_mass_error: f64::NAN,
+        max_momentum_error: f64::NAN,
         profile: None,
         probes: Vec::new(),
     }
@@ -499,4 +501,33 @@ fn probes_tables_list_every_run_and_name_unknown_probes() {
         .to_string();
     assert!(message.contains("probe 'root'"), "{message}");
     assert!(message.contains("the runs record: tip"), "{message}");
+}
+
+/// The conservation table lists every selected run's largest mapping errors as recorded.
+#[test]
+fn conservation_tables_list_each_runs_mapping_errors() {
+    let mut runs = vec![run("0.1", "mpm", 8), run("0.1", "usl", 8)];
+    runs[0].max_mass_error = 2.5e-15;
+    runs[0].max_momentum_error = 3.0e-16;
+    let mut exp = experiment(vec![], vec![]);
+    exp.tables = vec![TableSpec {
+        kind: TableKind::Conservation,
+        columns: None,
+        select: Params::new(),
+        stability: None,
+        measure: None,
+        probe: None,
+    }];
+    let dir = tempfile::tempdir().unwrap();
+    write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    let md = read(dir.path(), "report.md");
+    assert!(
+        md.contains("### Largest relative mass and momentum errors"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| 0.1 | mpm | 8 | ok | 2.5e-15 | 3e-16 |"),
+        "{md}"
+    );
+    assert!(md.contains("| 0.1 | usl | 8 | ok | NaN | NaN |"), "{md}");
 }

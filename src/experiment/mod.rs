@@ -235,6 +235,9 @@ pub enum TableKind {
     /// One row per run: how a probe's history settles against its reference after a time
     /// (Molinos Figs 10-11: which runs stay stable, when the others leave).
     Probes,
+    /// One row per run: the largest relative mass and momentum errors of its mappings
+    /// (Wobbes Table 3).
+    Conservation,
 }
 
 #[derive(Clone, Debug, PartialEq)]

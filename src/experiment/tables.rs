@@ -25,6 +25,7 @@ const KINDS: Kinds<TableKind> = Kinds {
         ("element_fits", TableKind::ElementFits),
         ("errors", TableKind::Errors),
         ("probes", TableKind::Probes),
+        ("conservation", TableKind::Conservation),
     ],
     keys: &[
         "kind",
@@ -149,7 +150,7 @@ fn probe_window(entries: &[Entry], node: &Node, parent: &str) -> Result<ProbeWin
 fn takes(kind: &TableKind) -> &'static [&'static str] {
     match kind {
         TableKind::NodalErrors => &["columns"],
-        TableKind::BasisNorms | TableKind::ElementFits => &[],
+        TableKind::BasisNorms | TableKind::ElementFits | TableKind::Conservation => &[],
         TableKind::Stability => &["x", "sweep"],
         TableKind::Errors => &["field", "norm"],
         TableKind::Probes => &["probe", "after", "tolerance"],
@@ -167,6 +168,6 @@ fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
         TableKind::Stability => benchmark == BenchmarkKind::Simulation,
         TableKind::ElementFits => benchmark == BenchmarkKind::Elementwise,
         TableKind::Errors => true,
-        TableKind::Probes => benchmark == BenchmarkKind::Simulation,
+        TableKind::Probes | TableKind::Conservation => benchmark == BenchmarkKind::Simulation,
     }
 }

@@ -132,6 +132,10 @@ pub struct RunSummary {
     pub shape_functions: Option<ShapeFunctionRecord>,
     /// The l2 velocity error at every sample of a simulation run that took any.
     pub velocity_history: Option<VelocityHistory>,
+    /// The `/conservation` attributes (largest relative mass and momentum errors of the run's
+    /// mappings); NaN for a run that has none.
+    pub max_mass_error: f64,
+    pub max_momentum_error: f64,
     /// The state at the last sample of a 1D simulation run, when the report compares runs
     /// with a reference run or draws fields along the bar (`collect` fills it).
     pub profile: Option<Profile>,

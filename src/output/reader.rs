@@ -69,9 +69,18 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         elements,
         shape_functions,
         velocity_history,
+        max_mass_error: conservation_attr(&file, "max_mass_error"),
+        max_momentum_error: conservation_attr(&file, "max_momentum_error"),
         profile: None,
         probes: Vec::new(),
     })
+}
+
+/// A `/conservation` attribute; NaN where the file has none (unstepped runs).
+fn conservation_attr(file: &hdf5::File, name: &str) -> f64 {
+    file.group("conservation")
+        .and_then(|g| read_f64(&g, name))
+        .unwrap_or(f64::NAN)
 }
 
 /// The `/probes` of a run file (none for a run without them).

@@ -33,6 +33,7 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Table>
             TableKind::ElementFits => tables.extend(element_fits(experiment, selected)),
             TableKind::Errors => tables.extend(final_errors(experiment, selected, spec)),
             TableKind::Probes => tables.extend(probe_table::table(experiment, selected, spec)?),
+            TableKind::Conservation => tables.extend(conservation(experiment, selected, spec)),
         }
     }
     Ok(tables)
@@ -251,6 +252,45 @@ fn final_errors<'a>(
                  the exact range (`/probes/<name>` attributes)."
             }
         ),
+        header,
+        rows,
+    })
+}
+
+/// One row per run in the order of the run tables: its axis values, status and the largest
+/// relative mass and momentum errors of its mappings (Wobbes Table 3), from `/conservation`.
+fn conservation<'a>(
+    experiment: &Experiment,
+    runs: impl Iterator<Item = &'a RunSummary>,
+    spec: &TableSpec,
+) -> Option<Table> {
+    let runs: Vec<RunSummary> = runs.cloned().collect();
+    if runs.is_empty() {
+        return None;
+    }
+    let mut header = experiment.axes.clone();
+    header.extend(["status", "mass error", "momentum error"].map(String::from));
+    let rows = ordered_runs(&runs)
+        .into_iter()
+        .map(|run| {
+            let mut row: Vec<String> = axis_values(experiment, run).collect();
+            row.push(run.status.as_str().to_string());
+            row.push(general(run.max_mass_error, 4));
+            row.push(general(run.max_momentum_error, 4));
+            row
+        })
+        .collect();
+    Some(Table {
+        title: format!(
+            "Largest relative mass and momentum errors{}",
+            title_suffix(&label(&spec.select))
+        ),
+        note: "Over every particle-to-grid mapping of the run (each step's transfer and MUSL's \
+               velocity remap), the largest |sum_i m_i - sum_p M_p| / sum_p M_p and \
+               |sum_i p_i - sum_p M_p v_p| / sum_p M_p |v_p| (`/conservation` attributes \
+               `max_mass_error`, `max_momentum_error`; Wobbes et al. Table 3); NaN for a run \
+               that never mapped."
+            .to_string(),
         header,
         rows,
     })

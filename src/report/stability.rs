@@ -287,6 +287,8 @@ mod tests {
                 l2_error: errors.to_vec(),
                 initial_l2: 2.0,
             }),
+            max_mass_error: f64::NAN,
+            max_momentum_error: f64::NAN,
             profile: None,
             probes: Vec::new(),
         }
