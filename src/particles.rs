@@ -6,8 +6,9 @@ use crate::benchmarks::Problem;
 use crate::reconstruct::gauss_legendre_rule;
 use crate::shape::{lattice_coords, Grid};
 
-/// State carried by the material points. Velocities are the leapfrog half-step values
-/// v^{s-1/2} between steps (v^0 before the first).
+/// State carried by the material points. Velocities are what the integrator steps: the
+/// leapfrog's half-step values v^{s-1/2} between steps (v^0 before the first), the whole-step
+/// values of the others.
 pub struct Particles<const D: usize> {
     /// Reference (initial) positions X_p.
     pub x0: Vec<SVector<f64, D>>,

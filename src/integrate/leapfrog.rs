@@ -1,8 +1,8 @@
 //! Leapfrog with half-step velocities and the particle update of Gong sec 4.4 (and of IMPM,
 //! sec 5.4). Between steps the particles carry v^{s-1/2}; the first step is a half kick
-//! (v^{1/2} = v^0 + a^0 dt/2, as Gong suggests after eq 4.24). The same update serves the
-//! predictor-corrector (with the grid's carried velocity) and forward Euler (whole kicks,
-//! moved with the start-of-step velocity).
+//! (v^{1/2} = v^0 + a^0 dt/2, as Gong suggests after eq 4.24). The same update serves USL
+//! (whole kicks from the start) and forward Euler (whole kicks, moved with the start-of-step
+//! velocity).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -20,8 +20,8 @@ use crate::shape::Stencils;
 /// found at the start of the step, i.e. x_p^s, which is what is done here (docs/NOTES.md).
 ///
 /// The particles move with the nodal velocity `drift`: the updated one `grid.velocity_new`
-/// (leapfrog, predictor-corrector) or the start-of-step one `grid.velocity` (forward Euler,
-/// Molinos et al. eq 22); F always follows `grid.velocity_new`.
+/// (leapfrog, USL) or the start-of-step one `grid.velocity` (forward Euler, Molinos et al.
+/// eq 22); F always follows `grid.velocity_new`.
 pub fn update_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
