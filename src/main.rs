@@ -282,6 +282,10 @@ fn list_methods() {
         );
         println!("{:<15} {}", "", preset.method);
     }
+    println!("\nMethod parameters (in params or as matrix axes of any simulation):");
+    for p in methods::METHOD_PARAMS {
+        print_param(p);
+    }
     println!("\nReference solvers (simulation benchmarks they name):");
     for m in reference::methods() {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
@@ -320,20 +324,25 @@ fn list_benchmarks() {
             b.name, b.description, b.source
         );
         for p in b.params {
-            let default = match p.default {
-                benchmarks::ParamDefault::Required => "required".to_string(),
-                benchmarks::ParamDefault::Int(i) => format!("default {i}"),
-                benchmarks::ParamDefault::Float(x) => format!("default {x:?}"),
-                benchmarks::ParamDefault::Text(s) => format!("default {s}"),
-            };
-            let choices = match p.kind {
-                benchmarks::ParamKind::Choice(names) => format!(" (one of: {})", names.join(", ")),
-                _ => String::new(),
-            };
-            println!(
-                "  {:<8} {:<17} [{}] {}{choices}",
-                p.key, default, p.unit, p.doc
-            );
+            print_param(p);
         }
     }
+}
+
+/// One parameter: key, default, unit, meaning and the choices it takes.
+fn print_param(p: &benchmarks::ParamSpec) {
+    let default = match p.default {
+        benchmarks::ParamDefault::Required => "required".to_string(),
+        benchmarks::ParamDefault::Int(i) => format!("default {i}"),
+        benchmarks::ParamDefault::Float(x) => format!("default {x:?}"),
+        benchmarks::ParamDefault::Text(s) => format!("default {s}"),
+    };
+    let choices = match p.kind {
+        benchmarks::ParamKind::Choice(names) => format!(" (one of: {})", names.join(", ")),
+        _ => String::new(),
+    };
+    println!(
+        "  {:<8} {:<17} [{}] {}{choices}",
+        p.key, default, p.unit, p.doc
+    );
 }
