@@ -169,6 +169,22 @@ pub fn slug(text: &str) -> String {
     out.trim_end_matches('_').to_string()
 }
 
+/// The names of the probes `runs` record, sorted, for a message about a missing one; `none`
+/// when they record none.
+pub fn recorded_probes<'a>(runs: impl IntoIterator<Item = &'a RunSummary>) -> String {
+    let mut names: Vec<&str> = runs
+        .into_iter()
+        .flat_map(|run| run.probes.iter().map(|p| p.name.as_str()))
+        .collect();
+    names.sort_unstable();
+    names.dedup();
+    if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,7 +3,7 @@
 //! numbers come from `/probes/<name>` unchanged.
 
 use super::format::general;
-use super::group::{axis_values, label, ordered_runs, title_suffix};
+use super::group::{axis_values, label, ordered_runs, recorded_probes, title_suffix};
 use super::pointwise::Table;
 use crate::experiment::{Experiment, ProbeWindow, TableSpec};
 use crate::output::{ProbeRecord, RunSummary};
@@ -23,21 +23,11 @@ pub fn table<'a>(
     }
     let probe_of = |run: &RunSummary| run.probes.iter().find(|p| p.name == window.name).cloned();
     let Some(unit) = runs.iter().find_map(probe_of).map(|p| p.unit()) else {
-        let mut recorded: Vec<&str> = runs
-            .iter()
-            .flat_map(|run| run.probes.iter().map(|p| p.name.as_str()))
-            .collect();
-        recorded.sort_unstable();
-        recorded.dedup();
         return Err(format!(
             "probes table: no selected run of {} records the probe '{}'; the runs record: {}",
             experiment.name,
             window.name,
-            if recorded.is_empty() {
-                "none".to_string()
-            } else {
-                recorded.join(", ")
-            }
+            recorded_probes(&runs)
         ));
     };
     let mut header = experiment.axes.clone();

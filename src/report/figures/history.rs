@@ -6,7 +6,7 @@ use super::{Figure, Marker, Names, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec};
 use crate::output::{ProbeRecord, RunStatus, RunSummary};
 use crate::report::format::general;
-use crate::report::group::{group_runs, label, label_or_all, title_suffix};
+use crate::report::group::{group_runs, label, label_or_all, recorded_probes, title_suffix};
 
 /// Names of the components of vectors and tensors, by index.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -23,21 +23,11 @@ pub(super) fn figures(
         return Ok(Vec::new());
     };
     if runs.iter().all(|run| probe_of(run, name).is_none()) {
-        let mut known: Vec<&str> = runs
-            .iter()
-            .flat_map(|run| run.probes.iter().map(|p| p.name.as_str()))
-            .collect();
-        known.sort_unstable();
-        known.dedup();
-        let known = if known.is_empty() {
-            "none".to_string()
-        } else {
-            known.join(", ")
-        };
         return Err(format!(
             "history figure: no selected run of {} records the probe '{name}'; the runs record: \
-             {known}",
-            experiment.name
+             {}",
+            experiment.name,
+            recorded_probes(runs.iter().copied())
         ));
     }
     let drop: Vec<&str> = spec.by.iter().map(String::as_str).collect();
