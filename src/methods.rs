@@ -489,20 +489,13 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
         }
         check_lme(lme, dim)?;
     } else {
-        for key in [GAMMA_KEY, LME_TOLERANCE_KEY] {
-            if params.contains_key(key) {
-                return Err(ParamError::new(
-                    key,
-                    format!(
-                        "{key} applies to LME methods only ({}), not to {}; put the LME runs \
-                         in a matrix block of their own",
-                        preset_names_where(|m| matches!(m.shape, ShapeKind::LocalMaxEnt(_)))
-                            .join(", "),
-                        preset.name
-                    ),
-                ));
-            }
-        }
+        refuse(
+            params,
+            &[GAMMA_KEY, LME_TOLERANCE_KEY],
+            preset,
+            "LME methods",
+            |m| matches!(m.shape, ShapeKind::LocalMaxEnt(_)),
+        )?;
     }
     if params.contains_key(INTEGRATOR_KEY) {
         let name = get_str(params, INTEGRATOR_KEY)?;
@@ -537,21 +530,38 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
             })?;
         }
     } else {
-        for key in [GAUSS_POINTS_KEY, BODY_FORCE_FIT_KEY] {
-            if params.contains_key(key) {
-                return Err(ParamError::new(
-                    key,
-                    format!(
-                        "{key} applies to the quadrature transfers only ({}), not to {}",
-                        preset_names_where(|m| matches!(m.transfer, TransferKind::Quadrature(_)))
-                            .join(", "),
-                        preset.name
-                    ),
-                ));
-            }
-        }
+        refuse(
+            params,
+            &[GAUSS_POINTS_KEY, BODY_FORCE_FIT_KEY],
+            preset,
+            "the quadrature transfers",
+            |m| matches!(m.transfer, TransferKind::Quadrature(_)),
+        )?;
     }
     Ok(method)
+}
+
+/// Refuses the first of `keys` the run sets: they apply to `which` only (the presets that
+/// satisfy `applies`), not to `preset`; put such runs in a matrix block of their own.
+fn refuse(
+    params: &Params,
+    keys: &[&str],
+    preset: &MethodPreset,
+    which: &str,
+    applies: impl Fn(&Method) -> bool,
+) -> Result<(), ParamError> {
+    match keys.iter().find(|key| params.contains_key(**key)) {
+        None => Ok(()),
+        Some(key) => Err(ParamError::new(
+            key,
+            format!(
+                "{key} applies to {which} only ({}), not to {}; put those runs in a matrix block \
+                 of their own",
+                preset_names_where(applies).join(", "),
+                preset.name
+            ),
+        )),
+    }
 }
 
 /// Refuses an `integrator` the preset's transfer cannot run, naming the presets that can.
