@@ -22,7 +22,9 @@ use crate::particles::Particles;
 use crate::reconstruct::{map_velocity, GridState};
 use crate::shape::Stencils;
 
-/// The particle accelerations the predictor needs, and the scratch arrays of one step.
+/// The particle accelerations the predictor needs, and the scratch arrays of one step; sized
+/// by the first step, so a run of another integrator allocates nothing.
+#[derive(Default)]
 pub struct PredictorCorrector<const D: usize> {
     /// a_p of the last step; zero before the first.
     acceleration: Vec<SVector<f64, D>>,
@@ -33,14 +35,6 @@ pub struct PredictorCorrector<const D: usize> {
 }
 
 impl<const D: usize> PredictorCorrector<D> {
-    pub fn new(particles: usize, nodes: usize) -> Self {
-        PredictorCorrector {
-            acceleration: vec![SVector::zeros(); particles],
-            predicted: vec![SVector::zeros(); particles],
-            drift: vec![SVector::zeros(); nodes],
-        }
-    }
-
     /// Step 1 before the boundary conditions: the nodal mass and the predictor v~_i in
     /// `grid.velocity` (empty nodes at rest); `grid.force` is cleared.
     pub fn predict(
@@ -50,6 +44,8 @@ impl<const D: usize> PredictorCorrector<D> {
         dt: f64,
         grid: &mut GridState<D>,
     ) {
+        self.acceleration.resize(particles.len(), SVector::zeros());
+        self.predicted.resize(particles.len(), SVector::zeros());
         for ((u, v), a) in self
             .predicted
             .iter_mut()
@@ -77,6 +73,7 @@ impl<const D: usize> PredictorCorrector<D> {
         dt: f64,
     ) -> &[SVector<f64, D>] {
         solve_grid(grid, fixed, 0.5 * dt);
+        self.drift.resize(grid.mass.len(), SVector::zeros());
         for ((d, v), a) in self
             .drift
             .iter_mut()
@@ -138,8 +135,10 @@ mod tests {
         let (mut particles, stencils) = one_particle(0.25);
         particles.mass[0] = 2.0;
         particles.v[0] = SVector::repeat(1.0);
-        let mut pc = PredictorCorrector::<1>::new(1, 2);
-        pc.acceleration[0] = SVector::repeat(4.0);
+        let mut pc = PredictorCorrector::<1> {
+            acceleration: vec![SVector::repeat(4.0)],
+            ..Default::default()
+        };
         let mut grid = GridState::<1>::new(2, 2.0);
         let dt = 0.1;
         pc.predict(&stencils, &particles, dt, &mut grid);
@@ -164,7 +163,7 @@ mod tests {
     fn the_corrector_holds_fixed_components() {
         let (mut particles, stencils) = one_particle(0.5);
         particles.v[0] = SVector::repeat(3.0);
-        let mut pc = PredictorCorrector::<1>::new(1, 2);
+        let mut pc = PredictorCorrector::<1>::default();
         let mut grid = GridState::<1>::new(2, particles.mass[0]);
         pc.predict(&stencils, &particles, 0.1, &mut grid);
         assert!(grid.velocity.iter().all(|v| close(v[0], 3.0)));
@@ -186,7 +185,7 @@ mod tests {
             let (mut particles, stencils) = one_particle(1.0 - eps);
             particles.v[0] = SVector::repeat(1.0);
             particles.stress[0] = SMatrix::repeat(1.0e6);
-            let mut pc = PredictorCorrector::<1>::new(1, 2);
+            let mut pc = PredictorCorrector::<1>::default();
             let mut grid = GridState::<1>::new(2, particles.mass[0]);
             let dt = 1e-7;
             for step in 0..50 {
@@ -233,7 +232,7 @@ mod tests {
         let q = dt * dt * (young / h) * (volume / (h * mass));
         assert!((q - 0.01).abs() < 1e-12, "q = {q}");
         let fixed = [(0u32, 0u8)];
-        let mut pc = PredictorCorrector::<1>::new(1, 2);
+        let mut pc = PredictorCorrector::<1>::default();
         let mut grid = GridState::<1>::new(2, mass);
         let mut stress = vec![0.0];
         for _ in 0..400 {

@@ -144,6 +144,13 @@ pub struct RunSummary {
     pub probes: Vec<ProbeRecord>,
 }
 
+impl RunSummary {
+    /// The run's probe `name`, when `collect` read the probes and the run records it.
+    pub fn probe(&self, name: &str) -> Option<&ProbeRecord> {
+        self.probes.iter().find(|p| p.name == name)
+    }
+}
+
 /// The last sample of a 1D simulation run, one value per particle (per element for a
 /// reference solver), from `/particles`, `/history` and `/errors/volume`.
 #[derive(Clone, Debug, PartialEq)]

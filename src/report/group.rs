@@ -47,7 +47,7 @@ pub fn group_runs<'a>(
 }
 
 /// Every run, grouped and coarsest first within a group: the order of the run tables.
-pub fn ordered_runs(runs: &[RunSummary]) -> Vec<&RunSummary> {
+pub fn ordered_runs<'a>(runs: impl IntoIterator<Item = &'a RunSummary>) -> Vec<&'a RunSummary> {
     group_runs(runs, &[REFINEMENT_AXIS])
         .into_iter()
         .flat_map(|g| g.runs)

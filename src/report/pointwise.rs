@@ -186,54 +186,67 @@ fn element_fits<'a>(
     })
 }
 
-/// One row per run in the order of the run tables: its axis values, status and final error in
-/// the spec's field and norm (empty for a run that stopped before its final time), then for
-/// each probe of that field with a reference the wiggle measures of its history: the total
-/// variation against the reference's and the overshoot past the reference's range.
+/// The header and rows of a table with one row per run, in the order of the run tables: the
+/// run's axis values and status, then `columns`, filled by `cells`.
+pub(super) fn per_run_rows(
+    experiment: &Experiment,
+    runs: &[&RunSummary],
+    columns: impl IntoIterator<Item = String>,
+    cells: impl Fn(&RunSummary) -> Vec<String>,
+) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut header = experiment.axes.clone();
+    header.push("status".to_string());
+    header.extend(columns);
+    let rows = runs
+        .iter()
+        .map(|run| {
+            let mut row: Vec<String> = axis_values(experiment, run).collect();
+            row.push(run.status.as_str().to_string());
+            row.extend(cells(run));
+            row
+        })
+        .collect();
+    (header, rows)
+}
+
+/// One row per run: its final error in the spec's field and norm (empty for a run that stopped
+/// before its final time), then for each probe of that field with a reference the wiggle
+/// measures of its history: the total variation against the reference's and the overshoot
+/// past the reference's range.
 fn final_errors<'a>(
     experiment: &Experiment,
     runs: impl Iterator<Item = &'a RunSummary>,
     spec: &TableSpec,
 ) -> Option<Table> {
     let (field, norm) = spec.measure.as_ref()?;
-    let runs: Vec<RunSummary> = runs.cloned().collect();
+    let runs = ordered_runs(runs);
     if runs.is_empty() {
         return None;
     }
     let probes = compared_probes(&runs, field);
-    let mut header = experiment.axes.clone();
-    header.extend(["status".to_string(), format!("{norm} {field} error")]);
+    let mut columns = vec![format!("{norm} {field} error")];
     for (name, unit) in &probes {
-        header.push(format!("{name}: TV / exact TV"));
-        header.push(format!("{name}: overshoot ({unit})"));
+        columns.push(format!("{name}: TV / exact TV"));
+        columns.push(format!("{name}: overshoot ({unit})"));
     }
-    let rows = ordered_runs(&runs)
-        .into_iter()
-        .map(|run| {
-            let mut row: Vec<String> = axis_values(experiment, run).collect();
-            let error = run.final_norms.get(&(field.clone(), norm.clone()));
-            let finished = run.status == RunStatus::Ok;
-            let shown = |value: Option<f64>| {
-                value
-                    .filter(|_| finished)
-                    .map_or_else(String::new, |e| general(e, 4))
-            };
-            row.push(run.status.as_str().to_string());
-            row.push(shown(error.copied()));
-            for (name, _) in &probes {
-                let wiggles = run
-                    .probes
-                    .iter()
-                    .find(|p| &p.name == name)
-                    .map(|p| p.wiggles());
-                row.push(shown(
-                    wiggles.map(|w| w.total_variation / w.reference_total_variation),
-                ));
-                row.push(shown(wiggles.map(|w| w.overshoot)));
-            }
-            row
-        })
-        .collect();
+    let (header, rows) = per_run_rows(experiment, &runs, columns, |run| {
+        let finished = run.status == RunStatus::Ok;
+        let shown = |value: Option<f64>| {
+            value
+                .filter(|_| finished)
+                .map_or_else(String::new, |e| general(e, 4))
+        };
+        let error = run.final_norms.get(&(field.clone(), norm.clone()));
+        let mut cells = vec![shown(error.copied())];
+        for (name, _) in &probes {
+            let wiggles = run.probe(name).map(|p| p.wiggles());
+            cells.push(shown(
+                wiggles.map(|w| w.total_variation / w.reference_total_variation),
+            ));
+            cells.push(shown(wiggles.map(|w| w.overshoot)));
+        }
+        cells
+    });
     Some(Table {
         title: format!(
             "Final {norm} {field} error{}",
@@ -257,29 +270,24 @@ fn final_errors<'a>(
     })
 }
 
-/// One row per run in the order of the run tables: its axis values, status and the largest
-/// relative mass and momentum errors of its mappings (Wobbes Table 3), from `/conservation`.
+/// One row per run: the largest relative mass and momentum errors of its mappings (Wobbes
+/// Table 3), from `/conservation`.
 fn conservation<'a>(
     experiment: &Experiment,
     runs: impl Iterator<Item = &'a RunSummary>,
     spec: &TableSpec,
 ) -> Option<Table> {
-    let runs: Vec<RunSummary> = runs.cloned().collect();
+    let runs = ordered_runs(runs);
     if runs.is_empty() {
         return None;
     }
-    let mut header = experiment.axes.clone();
-    header.extend(["status", "mass error", "momentum error"].map(String::from));
-    let rows = ordered_runs(&runs)
-        .into_iter()
-        .map(|run| {
-            let mut row: Vec<String> = axis_values(experiment, run).collect();
-            row.push(run.status.as_str().to_string());
-            row.push(general(run.max_mass_error, 4));
-            row.push(general(run.max_momentum_error, 4));
-            row
-        })
-        .collect();
+    let columns = ["mass error", "momentum error"].map(String::from);
+    let (header, rows) = per_run_rows(experiment, &runs, columns, |run| {
+        vec![
+            general(run.max_mass_error, 4),
+            general(run.max_momentum_error, 4),
+        ]
+    });
     Some(Table {
         title: format!(
             "Largest relative mass and momentum errors{}",
@@ -298,7 +306,7 @@ fn conservation<'a>(
 
 /// The probes of `field` that have a reference, by name and unit, in the order of the first
 /// run that records each.
-fn compared_probes(runs: &[RunSummary], field: &str) -> Vec<(String, &'static str)> {
+fn compared_probes(runs: &[&RunSummary], field: &str) -> Vec<(String, &'static str)> {
     let mut probes: Vec<(String, &'static str)> = Vec::new();
     for probe in runs.iter().flat_map(|run| &run.probes) {
         let compared = probe.quantity == field && probe.reference_kind == "exact";

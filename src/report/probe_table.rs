@@ -3,8 +3,8 @@
 //! numbers come from `/probes/<name>` unchanged.
 
 use super::format::general;
-use super::group::{axis_values, label, ordered_runs, recorded_probes, title_suffix};
-use super::pointwise::Table;
+use super::group::{label, ordered_runs, recorded_probes, title_suffix};
+use super::pointwise::{per_run_rows, Table};
 use crate::experiment::{Experiment, ProbeWindow, TableSpec};
 use crate::output::{ProbeRecord, RunSummary};
 
@@ -17,52 +17,46 @@ pub fn table<'a>(
     let Some(window) = &spec.probe else {
         return Ok(None);
     };
-    let runs: Vec<RunSummary> = runs.cloned().collect();
+    let runs = ordered_runs(runs);
     if runs.is_empty() {
         return Ok(None);
     }
-    let probe_of = |run: &RunSummary| run.probes.iter().find(|p| p.name == window.name).cloned();
-    let Some(unit) = runs.iter().find_map(probe_of).map(|p| p.unit()) else {
+    let Some(unit) = runs
+        .iter()
+        .find_map(|run| run.probe(&window.name))
+        .map(|p| p.unit())
+    else {
         return Err(format!(
             "probes table: no selected run of {} records the probe '{}'; the runs record: {}",
             experiment.name,
             window.name,
-            recorded_probes(&runs)
+            recorded_probes(runs.iter().copied())
         ));
     };
-    let mut header = experiment.axes.clone();
-    header.push("status".to_string());
-    header.extend(
-        [
-            "mean",
-            "sd",
-            "reference at the end",
-            "largest |value - reference|",
-        ]
-        .map(|c| format!("{c} ({unit})")),
-    );
-    header.push("leaves at (s)".to_string());
-    let rows = ordered_runs(&runs)
-        .into_iter()
-        .map(|run| {
-            let mut row: Vec<String> = axis_values(experiment, run).collect();
-            row.push(run.status.as_str().to_string());
-            let settled = probe_of(run).and_then(|p| Settled::of(&p, window));
-            match settled {
-                Some(s) => {
-                    row.extend(
-                        [s.mean, s.sd, s.reference, s.largest_deviation].map(|x| general(x, 4)),
-                    );
-                    row.push(
-                        s.leaves_at
-                            .map_or_else(|| "never".to_string(), |t| general(t, 4)),
-                    );
-                }
-                None => row.extend(std::iter::repeat_n(String::new(), 5)),
+    let columns = [
+        "mean",
+        "sd",
+        "reference at the end",
+        "largest |value - reference|",
+    ]
+    .map(|c| format!("{c} ({unit})"))
+    .into_iter()
+    .chain(["leaves at (s)".to_string()]);
+    let (header, rows) = per_run_rows(experiment, &runs, columns, |run| {
+        match run.probe(&window.name).and_then(|p| Settled::of(p, window)) {
+            Some(s) => {
+                let mut cells: Vec<String> = [s.mean, s.sd, s.reference, s.largest_deviation]
+                    .map(|x| general(x, 4))
+                    .into();
+                cells.push(
+                    s.leaves_at
+                        .map_or_else(|| "never".to_string(), |t| general(t, 4)),
+                );
+                cells
             }
-            row
-        })
-        .collect();
+            None => vec![String::new(); 5],
+        }
+    });
     Ok(Some(Table {
         title: format!(
             "Probe {} after t = {}{}",

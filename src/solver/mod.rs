@@ -123,7 +123,7 @@ struct Run<'a, const D: usize> {
     body_force: Vec<SVector<f64, D>>,
     /// Nodal velocity rebuilt after the particles moved (MUSL and eqs 23-24 only).
     remapped: Vec<SVector<f64, D>>,
-    /// The particle accelerations and scratch of the predictor-corrector (unused by the
+    /// The particle accelerations and scratch of the predictor-corrector (left empty by the
     /// other integrators).
     predictor: PredictorCorrector<D>,
     fits: FitStats,
@@ -181,7 +181,7 @@ impl<'a, const D: usize> Run<'a, D> {
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
-            predictor: PredictorCorrector::new(n, grid.num_nodes()),
+            predictor: PredictorCorrector::default(),
             grid,
             particles,
             fixed,

@@ -22,7 +22,7 @@ pub(super) fn figures(
     let Some(name) = spec.probe.as_deref() else {
         return Ok(Vec::new());
     };
-    if runs.iter().all(|run| probe_of(run, name).is_none()) {
+    if runs.iter().all(|run| run.probe(name).is_none()) {
         return Err(format!(
             "history figure: no selected run of {} records the probe '{name}'; the runs record: \
              {}",
@@ -36,7 +36,7 @@ pub(super) fn figures(
         let probes: Vec<(&RunSummary, &ProbeRecord)> = group
             .runs
             .iter()
-            .filter_map(|run| Some((*run, probe_of(run, name)?)))
+            .filter_map(|run| Some((*run, run.probe(name)?)))
             .filter(|(_, probe)| !probe.time.is_empty())
             .collect();
         let Some((_, first)) = probes.first() else {
@@ -57,10 +57,6 @@ pub(super) fn figures(
         });
     }
     Ok(figures)
-}
-
-fn probe_of<'r>(run: &'r RunSummary, name: &str) -> Option<&'r ProbeRecord> {
-    run.probes.iter().find(|p| p.name == name)
 }
 
 /// The run's values over time, labelled with its values of the `by` axes (all its axes when
