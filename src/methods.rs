@@ -9,7 +9,7 @@ use crate::reconstruct::{
     BodyForceFit, Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe,
     Weight,
 };
-use crate::shape::{DomainShape, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
+use crate::shape::{DomainShape, DualIntegrals, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
 
 /// Basis functions used on the background grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,8 +22,9 @@ pub enum ShapeKind {
     /// in 2D): cells + 2 DOFs per axis (BSMPM; Steffen et al. 2008, Tielen et al. 2017).
     QuadraticBSpline,
     /// The hat's values with the dual-domain gradient, the hat's gradient averaged over the
-    /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011).
-    DualDomain,
+    /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011), the integrals taken
+    /// as given.
+    DualDomain(DualIntegrals),
     /// Local maximum-entropy functions on the grid nodes (Arroyo & Ortiz 2006; Molinos et al.
     /// sec 5), with the locality gamma and the neighbour cut-off of the run.
     LocalMaxEnt(LmeSettings),
@@ -47,6 +48,10 @@ pub enum TransferKind {
     /// Mass and forces lumped as in `Shepard`, the nodal velocity a least-squares fit of the
     /// particle velocities (improved CPDI, Gong sec 6.6).
     FittedVelocity(Recipe),
+    /// The sums of `Shepard` solved with the consistent mass matrix of the particle
+    /// quadrature, M_ij = sum_p M_p N_ip N_jp, for the velocity (Wobbes et al. eq 8 with the
+    /// full matrix), the acceleration and MUSL's remap.
+    ConsistentMass,
     /// Taylor least squares per element: stress fitted freely, density and momentum with the
     /// element's mass and momentum prescribed, integrated by Gauss quadrature (Wobbes et al.
     /// sec 3).
@@ -127,14 +132,46 @@ impl IntegratorKind {
     }
 }
 
+/// Which particle velocity a sample records for the whole-step schemes MUSL and USL.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampledVelocity {
+    /// The whole-step v_p^{s} = v_p^{s-1} + dt sum_i N_ip a_i^{s-1} the scheme steps (what
+    /// the CPLS code of Tran et al. writes).
+    Stepped,
+    /// That velocity read as the centred-difference half-step velocity v^{s-1/2} (with
+    /// v_i^{s} = v_i^{s-1} + dt a_i^{s-1} and x moved with it, MUSL and USL are the leapfrog
+    /// started without its half kick; Wallstedt & Guilkey 2008) and synchronised at the sample
+    /// as the leapfrog's: v_p + dt/2 sum_i N_ip a_i^s.
+    Centred,
+}
+
+impl SampledVelocity {
+    pub const NAMES: &'static [&'static str] = &["stepped", "centred"];
+
+    fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "stepped" => Some(SampledVelocity::Stepped),
+            "centred" => Some(SampledVelocity::Centred),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Method {
     pub shape: ShapeKind,
     pub transfer: TransferKind,
     pub integrator: IntegratorKind,
+    pub sampled_velocity: SampledVelocity,
 }
 
 impl Method {
+    /// Whether a sample adds dt/2 sum_i N_ip a_i^s to the particle velocity: the leapfrog's
+    /// half-step velocity always, MUSL's and USL's when read as centred differences.
+    pub fn synchronises_samples(&self) -> bool {
+        self.integrator.staggers_velocity() || self.sampled_velocity == SampledVelocity::Centred
+    }
+
     /// Whether the basis takes the particles' domains from the seed lattice's sub-cells.
     pub fn reads_seed_domains(&self) -> bool {
         matches!(self.shape, ShapeKind::Domain(_))
@@ -213,6 +250,7 @@ const fn on_domains(
         shape: ShapeKind::Domain(shape),
         transfer,
         integrator,
+        sampled_velocity: SampledVelocity::Stepped,
     }
 }
 
@@ -221,6 +259,7 @@ const fn musl_on(shape: ShapeKind, transfer: TransferKind) -> Method {
         shape,
         transfer,
         integrator: IntegratorKind::Musl,
+        sampled_velocity: SampledVelocity::Stepped,
     }
 }
 
@@ -231,6 +270,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Shepard,
             integrator: IntegratorKind::Leapfrog,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Gong 2015, ch. 4",
         description: "original MPM: linear hat basis, lumped mass, leapfrog",
@@ -241,6 +281,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Shepard,
             integrator: IntegratorKind::Musl,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Sulsky et al. 1994; Tran et al. 2019, eqs 31-40 with Shepard mapping",
         description: "original MPM mapping with the modified update-stress-last step",
@@ -251,6 +292,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Quadrature(IMPM),
             integrator: IntegratorKind::Leapfrog,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Gong 2015, ch. 5",
         description: "improved MPM: MLS velocity at nodes, MLS density/stress at cell centres",
@@ -261,6 +303,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Quadrature(IMLS),
             integrator: IntegratorKind::Musl,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Tran, Berzins, Solowski 2019",
         description: "IMLS-MPM: IMLS velocity at nodes, IMLS fields at 2 Gauss points, MUSL",
@@ -271,6 +314,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Quadrature(IMLS_CPLS),
             integrator: IntegratorKind::Usl,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Tran, Berzins, Solowski 2019, as their CPLS code runs it (IMLS_MPM_solver.m)",
         description:
@@ -282,6 +326,7 @@ const PRESETS: &[MethodPreset] = &[
             shape: ShapeKind::Linear,
             transfer: TransferKind::Quadrature(IMLS_EQ27),
             integrator: IntegratorKind::Musl,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Tran, Berzins, Solowski 2019, eq 27 as printed",
         description: "IMLS-MPM with the field weight scaled by 2h (support 3h)",
@@ -367,6 +412,7 @@ const PRESETS: &[MethodPreset] = &[
             }),
             transfer: TransferKind::Shepard,
             integrator: IntegratorKind::PredictorCorrector,
+            sampled_velocity: SampledVelocity::Stepped,
         },
         source: "Molinos, Navas, Pastor, Stickle, secs 4-5",
         description: "local max-ent basis (gamma from the run), lumped mass, predictor-corrector",
@@ -378,10 +424,31 @@ const PRESETS: &[MethodPreset] = &[
         description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
     },
     MethodPreset {
+        name: "bsmpm_consistent",
+        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::ConsistentMass),
+        source: "Wobbes et al. 2018, eq 8 with the consistent mass matrix",
+        description: "B-spline MPM with the consistent mass matrix of the particle quadrature, \
+                      MUSL",
+    },
+    MethodPreset {
         name: "ddmpm",
-        method: musl_on(ShapeKind::DualDomain, TransferKind::Shepard),
+        method: musl_on(
+            ShapeKind::DualDomain(DualIntegrals::Particles),
+            TransferKind::Shepard,
+        ),
         source: "Zhang, Ma & Giguere 2011; Wobbes et al. 2018",
-        description: "dual-domain MPM: hat values, node-averaged gradient, lumped mass, MUSL",
+        description: "dual-domain MPM: hat values, gradient averaged by particle sums over each \
+                      node's dual domain, lumped mass, MUSL",
+    },
+    MethodPreset {
+        name: "ddmpm_cells",
+        method: musl_on(
+            ShapeKind::DualDomain(DualIntegrals::ActiveCells),
+            TransferKind::Shepard,
+        ),
+        source: "Zhang, Ma & Giguere 2011, with exact integrals over the cells holding particles",
+        description: "dual-domain MPM with the averages integrated exactly over the active cells, \
+                      lumped mass, MUSL",
     },
     MethodPreset {
         name: "bsmpm_tls",
@@ -390,14 +457,30 @@ const PRESETS: &[MethodPreset] = &[
         description: "B-spline MPM with the conservative TLS mapping on each knot span, MUSL",
     },
     MethodPreset {
+        name: "bsmpm_tls_lumped",
+        method: musl_on(
+            ShapeKind::QuadraticBSpline,
+            TransferKind::Taylor(TLS_LUMPED),
+        ),
+        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+        description: "B-spline MPM with the conservative TLS mapping and the lumped mass matrix, \
+                      MUSL",
+    },
+    MethodPreset {
         name: "ddmpm_tls",
-        method: musl_on(ShapeKind::DualDomain, TransferKind::Taylor(TLS)),
+        method: musl_on(
+            ShapeKind::DualDomain(DualIntegrals::Particles),
+            TransferKind::Taylor(TLS),
+        ),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
         description: "dual-domain MPM with the conservative TLS mapping, MUSL",
     },
     MethodPreset {
         name: "ddmpm_tls_lumped",
-        method: musl_on(ShapeKind::DualDomain, TransferKind::Taylor(TLS_LUMPED)),
+        method: musl_on(
+            ShapeKind::DualDomain(DualIntegrals::Particles),
+            TransferKind::Taylor(TLS_LUMPED),
+        ),
         source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
         description:
             "dual-domain MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
@@ -421,6 +504,7 @@ pub const LME_TOLERANCE_KEY: &str = "lme_tolerance";
 pub const INTEGRATOR_KEY: &str = "integrator";
 pub const GAUSS_POINTS_KEY: &str = "gauss_points";
 pub const BODY_FORCE_FIT_KEY: &str = "body_force_fit";
+pub const SAMPLED_VELOCITY_KEY: &str = "sampled_velocity";
 
 /// Parameters of the method rather than the benchmark, settable in `params` or as matrix axes
 /// of any simulation. They have no defaults that enter a run: a run that does not set them has
@@ -462,6 +546,15 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
         unit: "",
         doc: "separate: rho and b fitted apart; product: one fit of rho_p b_p (quadrature \
               transfers only)",
+    },
+    ParamSpec {
+        key: SAMPLED_VELOCITY_KEY,
+        kind: ParamKind::Choice(SampledVelocity::NAMES),
+        default: ParamDefault::Text("stepped"),
+        unit: "",
+        doc: "the particle velocity MUSL and USL record: stepped, the whole-step velocity they \
+              step; centred, that velocity read as the centred difference's v^{s-1/2} and \
+              synchronised by dt/2 sum_i N_ip a_i^s as the leapfrog's (musl and usl only)",
     },
 ];
 
@@ -513,6 +606,9 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
         }
         method.integrator = integrator;
     }
+    if params.contains_key(SAMPLED_VELOCITY_KEY) {
+        method.sampled_velocity = sampled_velocity(preset, params, method.integrator)?;
+    }
     if let TransferKind::Quadrature(recipe) = &mut method.transfer {
         if params.contains_key(GAUSS_POINTS_KEY) {
             recipe.gauss_points = get_usize(params, GAUSS_POINTS_KEY)?;
@@ -539,6 +635,35 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
         )?;
     }
     Ok(method)
+}
+
+/// The run's `sampled_velocity`, which only the whole-step schemes MUSL and USL have a choice of.
+fn sampled_velocity(
+    preset: &MethodPreset,
+    params: &Params,
+    integrator: IntegratorKind,
+) -> Result<SampledVelocity, ParamError> {
+    let name = get_str(params, SAMPLED_VELOCITY_KEY)?;
+    let sampled = SampledVelocity::from_name(name).ok_or_else(|| {
+        ParamError::new(
+            SAMPLED_VELOCITY_KEY,
+            format!(
+                "unknown sampled_velocity '{name}'; valid: {}",
+                SampledVelocity::NAMES.join(", ")
+            ),
+        )
+    })?;
+    if matches!(integrator, IntegratorKind::Musl | IntegratorKind::Usl) {
+        return Ok(sampled);
+    }
+    Err(ParamError::new(
+        SAMPLED_VELOCITY_KEY,
+        format!(
+            "{SAMPLED_VELOCITY_KEY} applies to the musl and usl integrators only, not to {} with \
+             {integrator}; put those runs in a matrix block of their own",
+            preset.name
+        ),
+    ))
 }
 
 /// Refuses the first of `keys` the run sets: they apply to `which` only (the presets that
@@ -581,12 +706,12 @@ fn check_integrator(preset: &MethodPreset, integrator: IntegratorKind) -> Result
     ))
 }
 
-/// Whether `method`'s transfer can run `integrator`: the TLS transfers solve the grid with
-/// their own mass matrix, so they keep their integrator; the predictor-corrector maps its
+/// Whether `method`'s transfer can run `integrator`: the TLS and consistent-mass transfers
+/// solve the grid with their own mass matrix, so they keep their integrator; the predictor-corrector maps its
 /// predictor with the Shepard transfer.
 fn runs_with(method: &Method, integrator: IntegratorKind) -> bool {
     match method.transfer {
-        TransferKind::Taylor(_) => integrator == method.integrator,
+        TransferKind::Taylor(_) | TransferKind::ConsistentMass => integrator == method.integrator,
         TransferKind::Shepard => true,
         TransferKind::Quadrature(_) | TransferKind::FittedVelocity(_) => {
             integrator != IntegratorKind::PredictorCorrector
@@ -617,7 +742,10 @@ impl fmt::Display for ShapeKind {
             ShapeKind::Linear => f.write_str("linear"),
             ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
             ShapeKind::QuadraticBSpline => f.write_str("quadratic-bspline"),
-            ShapeKind::DualDomain => f.write_str("dual-domain"),
+            ShapeKind::DualDomain(DualIntegrals::Particles) => {
+                f.write_str("dual-domain(particles)")
+            }
+            ShapeKind::DualDomain(DualIntegrals::ActiveCells) => f.write_str("dual-domain(cells)"),
             ShapeKind::LocalMaxEnt(lme) => {
                 write!(f, "lme(gamma={}, tolerance={})", lme.gamma, lme.tolerance)
             }
@@ -629,6 +757,7 @@ impl fmt::Display for TransferKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             TransferKind::Shepard => f.write_str("shepard"),
+            TransferKind::ConsistentMass => f.write_str("consistent-mass"),
             TransferKind::Quadrature(recipe) => write!(f, "quadrature({recipe})"),
             TransferKind::FittedVelocity(recipe) => write!(f, "fitted-velocity({recipe})"),
             TransferKind::Taylor(recipe) => write!(f, "taylor({recipe})"),
@@ -648,7 +777,11 @@ impl fmt::Display for Method {
             f,
             "shape={} transfer={} integrate={}",
             self.shape, self.transfer, self.integrator
-        )
+        )?;
+        if self.sampled_velocity == SampledVelocity::Centred {
+            f.write_str(" sampled=centred")?;
+        }
+        Ok(())
     }
 }
 

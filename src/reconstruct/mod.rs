@@ -4,10 +4,12 @@
 
 mod banded;
 mod basis;
+mod consistent_mass;
 mod gauss;
 mod kernel;
 mod lattice;
 mod least_squares;
+mod mass_matrix;
 mod quadrature;
 mod shepard;
 mod solve;
@@ -19,6 +21,7 @@ mod tests;
 use nalgebra::SVector;
 
 pub use basis::{monomials, Degree, MAX_TERMS};
+pub use consistent_mass::ConsistentMassTransfer;
 pub use gauss::gauss_legendre_rule;
 pub use kernel::{Kernel, Weight};
 #[cfg(test)]
@@ -27,11 +30,12 @@ pub use lattice::Lattice;
 pub use least_squares::{
     FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,
 };
+pub use mass_matrix::{MassMatrix, MassSolver};
 pub use quadrature::{BodyForceFit, QuadratureRecipe, QuadratureTransfer};
 pub use shepard::{map_velocity, nodal_forces, particles_to_grid, remap_velocity};
 pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
 pub use taylor::{taylor_terms, Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
-pub use taylor_transfer::{MassMatrix, TaylorRecipe, TaylorTransfer};
+pub use taylor_transfer::{TaylorRecipe, TaylorTransfer};
 
 /// Nodal quantities assembled from the particles each step.
 pub struct GridState<const D: usize> {

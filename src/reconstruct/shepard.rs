@@ -16,6 +16,18 @@ pub fn particles_to_grid<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
+    particle_sums(stencils, particles, body_force, grid);
+    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
+}
+
+/// The sums of `particles_to_grid` with the momentum p_i = sum_p M_p v_p N_ip left in
+/// `grid.velocity`, for transfers that solve for the velocity with a mass matrix.
+pub fn particle_sums<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    body_force: &[SVector<f64, D>],
+    grid: &mut GridState<D>,
+) {
     grid.clear();
     for p in 0..particles.len() {
         let m = particles.mass[p];
@@ -28,7 +40,6 @@ pub fn particles_to_grid<const D: usize>(
             grid.force[i] += mb * w - vs * g;
         }
     }
-    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
 }
 
 /// The Shepard mapping of mass and of one velocity per particle, with no forces: m_i as in
@@ -77,6 +88,16 @@ pub fn remap_velocity<const D: usize>(
     grid: &GridState<D>,
     out: &mut [SVector<f64, D>],
 ) {
+    momentum_sums(stencils, particles, out);
+    momentum_to_velocity(out, &grid.mass, grid.empty_mass);
+}
+
+/// p_i = sum_p M_p v_p N_ip into `out`.
+pub fn momentum_sums<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    out: &mut [SVector<f64, D>],
+) {
     out.fill(SVector::zeros());
     for p in 0..particles.len() {
         let mv = particles.v[p] * particles.mass[p];
@@ -84,7 +105,6 @@ pub fn remap_velocity<const D: usize>(
             out[i] += mv * w;
         }
     }
-    momentum_to_velocity(out, &grid.mass, grid.empty_mass);
 }
 
 /// Divides nodal momenta by the nodal masses; empty nodes are left at rest.

@@ -10,22 +10,13 @@ use std::fmt;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::banded::BandMatrix;
 use super::gauss::gauss_legendre_rule;
+use super::mass_matrix::{MassMatrix, MassSolver};
 use super::taylor::{Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
 use super::{FitStats, GridState};
 use crate::integrate::{Divergence, FixedDof};
 use crate::particles::Particles;
 use crate::shape::{lattice_coords, Grid, Shape, Stencils};
-
-/// Which mass matrix the nodal velocity and acceleration are solved with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MassMatrix {
-    /// M_ij = sum_g rho_g N_i N_j omega_g (eq 10), solved by a banded Cholesky factorisation.
-    Consistent,
-    /// Its row sums m_i = sum_g rho_g N_i omega_g; as conservative as the consistent one.
-    Lumped,
-}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TaylorRecipe {
@@ -47,8 +38,6 @@ pub struct TaylorTransfer<const D: usize> {
     /// Weight of local Gauss point q, the same in every element.
     gauss_w: Vec<f64>,
     per_element: usize,
-    /// Per DOF and component: held at zero.
-    fixed: Vec<[bool; D]>,
     /// Sub-diagonals of the mass matrix in DOF numbering.
     bandwidth: usize,
     /// Particles sorted by element (a counting sort, stable in particle order).
@@ -65,12 +54,8 @@ pub struct TaylorTransfer<const D: usize> {
     /// mapping and reused by the remap, which fits the same points.
     prescribed: Vec<TaylorFit<D>>,
     fitted: TaylorFit<D>,
-    /// Consistent mass matrix in DOF numbering, and per component its factor restricted to
-    /// the DOFs that carry mass and are free (`free[k]` lists them in order).
-    mass_matrix: BandMatrix,
-    factors: Vec<BandMatrix>,
-    free: Vec<Vec<u32>>,
-    rhs: Vec<f64>,
+    /// The mass matrix of eq 10 (or its row sums) and its solve (eq 11).
+    mass_solver: MassSolver<D>,
     /// Sum of p_i of the last mapping: the momentum the DOFs received.
     momentum_total: SVector<f64, D>,
 }
@@ -109,18 +94,7 @@ impl<const D: usize> TaylorTransfer<D> {
         basis
             .update(shape, grid, &gauss_x)
             .expect("Gauss points lie inside their elements");
-        let bandwidth = (0..gauss_x.len())
-            .flat_map(|g| {
-                let nodes: Vec<usize> = basis.of(g).map(|(i, _, _)| i).collect();
-                let (lo, hi) = (nodes.iter().min(), nodes.iter().max());
-                lo.zip(hi).map(|(lo, hi)| hi - lo)
-            })
-            .max()
-            .unwrap_or(0);
-        let mut fixed_mask = vec![[false; D]; num_dofs];
-        for &(i, k) in fixed {
-            fixed_mask[i as usize][k as usize] = true;
-        }
+        let bandwidth = basis.bandwidth();
         TaylorTransfer {
             recipe,
             grid: grid.clone(),
@@ -128,7 +102,6 @@ impl<const D: usize> TaylorTransfer<D> {
             gauss_x,
             gauss_w,
             per_element,
-            fixed: fixed_mask,
             bandwidth,
             element_of: Vec::new(),
             element_start: vec![0; elements + 1],
@@ -139,10 +112,7 @@ impl<const D: usize> TaylorTransfer<D> {
             values: Vec::new(),
             prescribed: (0..elements).map(|_| TaylorFit::default()).collect(),
             fitted: TaylorFit::default(),
-            mass_matrix: BandMatrix::default(),
-            factors: vec![BandMatrix::default(); D],
-            free: vec![Vec::new(); D],
-            rhs: Vec::new(),
+            mass_solver: MassSolver::new(recipe.mass, num_dofs, fixed),
             momentum_total: SVector::zeros(),
         }
     }
@@ -167,9 +137,9 @@ impl<const D: usize> TaylorTransfer<D> {
     ) -> Result<FitStats, Divergence> {
         grid.clear();
         self.sort_by_element(particles)?;
-        let consistent = self.recipe.mass == MassMatrix::Consistent;
+        let consistent = self.mass_solver.is_consistent();
         if consistent {
-            self.mass_matrix.reset(grid.mass.len(), self.bandwidth);
+            self.mass_solver.reset(self.bandwidth);
         }
         let degree = self.recipe.degree;
         let mut stats = FitStats::default();
@@ -212,7 +182,7 @@ impl<const D: usize> TaylorTransfer<D> {
                     grid.force[i] -= sigma_g * grad;
                     if consistent {
                         for (j, n_j, _) in self.basis.of(g).filter(|&(j, _, _)| j <= i) {
-                            self.mass_matrix.add(i, j, rho_g * n_i * n_j);
+                            self.mass_solver.add(i, j, rho_g * n_i * n_j);
                         }
                     }
                 }
@@ -225,10 +195,11 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         if consistent {
-            self.factor_mass_matrix(grid)?;
+            self.mass_solver.factor(&grid.mass, grid.empty_mass)?;
         }
         self.momentum_total = grid.velocity.iter().sum();
-        self.solve(&grid.mass, grid.empty_mass, &mut grid.velocity);
+        self.mass_solver
+            .solve(&grid.mass, grid.empty_mass, &mut grid.velocity);
         Ok(stats)
     }
 
@@ -259,16 +230,12 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         self.momentum_total = out.iter().sum();
-        self.solve(&grid.mass, grid.empty_mass, out);
+        self.mass_solver.solve(&grid.mass, grid.empty_mass, out);
     }
 
-    /// The grid solve with this transfer's mass matrix: a = M^-1 f, v_new = v + kick a, fixed
-    /// components and empty DOFs held at zero. Afterwards `force` holds a.
+    /// The grid solve with this transfer's mass matrix (`MassSolver::solve_grid`).
     pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) {
-        self.solve(&grid.mass, grid.empty_mass, &mut grid.force);
-        for i in 0..grid.mass.len() {
-            grid.velocity_new[i] = grid.velocity[i] + grid.force[i] * kick;
-        }
+        self.mass_solver.solve_grid(grid, kick);
     }
 
     /// Total of p_i (eq 9) at the last mapping or remap: the momentum the DOFs received,
@@ -332,74 +299,6 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         coefficients
-    }
-
-    /// Factorises, per component, the consistent mass matrix restricted to the DOFs that carry
-    /// mass and are free in that component.
-    fn factor_mass_matrix(&mut self, grid: &GridState<D>) -> Result<(), Divergence> {
-        for k in 0..D {
-            let free = &mut self.free[k];
-            free.clear();
-            free.extend(
-                (0..grid.mass.len())
-                    .filter(|&i| grid.mass[i] > grid.empty_mass && !self.fixed[i][k])
-                    .map(|i| i as u32),
-            );
-            let factor = &mut self.factors[k];
-            factor.reset(free.len(), self.bandwidth);
-            for a in 0..free.len() {
-                let i = free[a] as usize;
-                for b in (0..=a).rev() {
-                    let j = free[b] as usize;
-                    if i - j > self.bandwidth {
-                        break;
-                    }
-                    factor.add(a, b, self.mass_matrix.get(i, j));
-                }
-            }
-            factor.factor().map_err(|e| {
-                Divergence::Reconstruction(format!(
-                    "the consistent mass matrix is not positive definite at DOF {} (pivot {:e})",
-                    free[e.row], e.pivot
-                ))
-            })?;
-        }
-        Ok(())
-    }
-
-    /// Solves M x = b in place for a nodal field; x is zero at fixed components and at DOFs
-    /// whose lumped mass `mass` is at most `empty_mass`.
-    fn solve(&mut self, mass: &[f64], empty_mass: f64, field: &mut [SVector<f64, D>]) {
-        match self.recipe.mass {
-            MassMatrix::Lumped => {
-                for (i, x) in field.iter_mut().enumerate() {
-                    let m = mass[i];
-                    for k in 0..D {
-                        x[k] = if m > empty_mass && !self.fixed[i][k] {
-                            x[k] / m
-                        } else {
-                            0.0
-                        };
-                    }
-                }
-            }
-            MassMatrix::Consistent => {
-                let mut rhs = std::mem::take(&mut self.rhs);
-                for k in 0..D {
-                    let free = &self.free[k];
-                    rhs.clear();
-                    rhs.extend(free.iter().map(|&i| field[i as usize][k]));
-                    self.factors[k].solve(&mut rhs);
-                    for x in field.iter_mut() {
-                        x[k] = 0.0;
-                    }
-                    for (&i, &x) in free.iter().zip(&rhs) {
-                        field[i as usize][k] = x;
-                    }
-                }
-                self.rhs = rhs;
-            }
-        }
     }
 
     /// Element `e`'s box.

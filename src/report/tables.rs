@@ -31,7 +31,10 @@ pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
     header.extend(experiment.axes.iter().cloned());
     header.extend(["h", "status"].map(String::from));
     if stepped {
-        header.extend(["steps", "dt"].map(String::from));
+        // A matrix axis `dt` holds the requested step; the run's own (shortened to hit
+        // t_end) then gets a name of its own, so that no two columns share one.
+        let taken = experiment.axes.iter().any(|a| a == "dt");
+        header.extend(["steps", if taken { "dt_used" } else { "dt" }].map(String::from));
     }
     header.push("wall_seconds".into());
     header.extend(norm_columns(measures).map(|(field, norm)| format!("{norm}_{field}")));

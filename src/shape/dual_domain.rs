@@ -2,7 +2,8 @@
 //! et al. (2018) use it: the values are the hat's, S_i(x) = N_i(x), and the gradient is the
 //! node average
 //!     grad S~_i(x) = sum_j S_j(x) (int grad S_i S_j) / (int S_j),
-//! with both integrals over the material, taken exactly over the cells that hold particles.
+//! with both integrals over the material: sums over the particles (as Zhang et al. and
+//! Wobbes et al. define it) or exact integrals over the cells that hold particles.
 
 use nalgebra::SVector;
 
@@ -15,18 +16,28 @@ const NEIGHBOURS_PER_AXIS: usize = 3;
 /// Hat corners of a cell in at most two dimensions.
 const MAX_CORNERS: usize = 4;
 
+/// How the integrals over the material are taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DualIntegrals {
+    /// MPM's particle quadrature, int f ~ sum_p f(x_p) V_p with the current volumes: the dual
+    /// domain of node j is the material under its hat as the particles carry it. A particle
+    /// crossing a node moves its whole share across the jump of grad N_i, so the averages
+    /// keep part of MPM's grid-crossing error (docs/NOTES.md).
+    Particles,
+    /// Exact integrals over the cells holding at least one particle. A body that fills the
+    /// grid gives the same, fixed, integrals whatever its particles do; a boundary cell that
+    /// the material fills in part counts as full.
+    ActiveCells,
+}
+
 /// The nodal integrals of one step, and through them the modified basis at any point.
 ///
-/// The material is the union of the active cells (those holding at least one particle), and
-/// the integrals over each of them are exact. A body that fills the grid gives the same,
-/// fixed, integrals whatever its particles do. Sums over the particles instead (MPM's
-/// particle quadrature) jump when a particle crosses a node, and that jump is MPM's
-/// grid-crossing error carried into the averaged gradient; integrals over the particles'
-/// boxes (cpGIMP domains) drift because the DDMPM gradient that updates F is not the one
-/// that moves the particles, so the boxes open gaps (docs/NOTES.md). A boundary cell that the
-/// material fills in part counts as full. A node whose hat covers no active cell
-/// (int S_j = 0) has no average and is dropped from the sum over j (see `eval`).
+/// A node whose hat covers no material (int S_j = 0) has no average and is dropped from the
+/// sum over j (see `eval`). Integrals over the particles' boxes (cpGIMP domains) were tried
+/// and dropped: the DDMPM gradient that updates F is not the one that moves the particles, so
+/// the boxes open gaps (docs/NOTES.md).
 pub struct DualDomain<const D: usize> {
+    integrals: DualIntegrals,
     /// Per cell, whether a particle is in it.
     active: Vec<bool>,
     /// int S_j per node j.
@@ -39,10 +50,11 @@ pub struct DualDomain<const D: usize> {
 
 impl<const D: usize> DualDomain<D> {
     /// Empty integrals on a grid of hat nodes.
-    pub fn new(grid: &Grid<D>) -> Self {
+    pub fn new(grid: &Grid<D>, integrals: DualIntegrals) -> Self {
         debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         let n = grid.num_nodes();
         DualDomain {
+            integrals,
             active: vec![false; grid.cells.pow(D as u32)],
             volume: vec![0.0; n],
             average: vec![SVector::zeros(); n * Self::neighbours()],
@@ -53,9 +65,61 @@ impl<const D: usize> DualDomain<D> {
         NEIGHBOURS_PER_AXIS.pow(D as u32)
     }
 
-    /// The integrals over the cells listed in `cells` (flat indices, `Grid::cell_index`; one
-    /// per particle), cell by cell in index order (a fixed summation order).
-    pub fn integrate(&mut self, grid: &Grid<D>, cells: &[usize]) {
+    /// The integrals over this step's material: the particles at `positions` with the
+    /// volumes `volumes`, each inside the cell listed in `cells` (flat indices,
+    /// `Grid::cell_index`). Sums run particle by particle, or cell by cell in index order: a
+    /// fixed summation order either way.
+    pub fn integrate(
+        &mut self,
+        grid: &Grid<D>,
+        positions: &[SVector<f64, D>],
+        volumes: &[f64],
+        cells: &[usize],
+    ) {
+        self.volume.fill(0.0);
+        self.average.fill(SVector::zeros());
+        match self.integrals {
+            DualIntegrals::Particles => self.sum_particles(grid, positions, volumes),
+            DualIntegrals::ActiveCells => self.integrate_cells(grid, cells),
+        }
+        let stride = Self::neighbours();
+        for (j, &volume) in self.volume.iter().enumerate() {
+            let scale = if volume > 0.0 { 1.0 / volume } else { 0.0 };
+            for g in &mut self.average[j * stride..(j + 1) * stride] {
+                *g *= scale;
+            }
+        }
+    }
+
+    /// int S_j ~ sum_p N_j(x_p) V_p and int grad S_i S_j ~ sum_p grad N_i(x_p) N_j(x_p) V_p.
+    fn sum_particles(&mut self, grid: &Grid<D>, positions: &[SVector<f64, D>], volumes: &[f64]) {
+        let corners = 1 << D;
+        let stride = Self::neighbours();
+        let mut node = [0u32; MAX_CORNERS];
+        let mut weight = [0.0; MAX_CORNERS];
+        let mut grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
+        for (x, &v) in positions.iter().zip(volumes) {
+            let (node, weight, grad) = (
+                &mut node[..corners],
+                &mut weight[..corners],
+                &mut grad[..corners],
+            );
+            // The solver has located every particle inside the grid.
+            let inside = LinearHat.eval(grid, x, node, weight, grad);
+            debug_assert!(inside);
+            for b in 0..corners {
+                let j = node[b] as usize;
+                let share = weight[b] * v;
+                self.volume[j] += share;
+                for a in 0..corners {
+                    self.average[j * stride + corner_offset::<D>(a, b)] += grad[a] * share;
+                }
+            }
+        }
+    }
+
+    /// The exact integrals over the active cells among `cells`.
+    fn integrate_cells(&mut self, grid: &Grid<D>, cells: &[usize]) {
         self.active.fill(false);
         for &c in cells {
             self.active[c] = true;
@@ -69,8 +133,6 @@ impl<const D: usize> DualDomain<D> {
         let product = |a: usize, b: usize| if a == b { h / 3.0 } else { h / 6.0 };
         let slope = |a: usize| if a == 0 { -0.5 } else { 0.5 };
         let cell_volume: f64 = value.powi(D as i32);
-        self.volume.fill(0.0);
-        self.average.fill(SVector::zeros());
         for (c, _) in self
             .active
             .iter()
@@ -96,12 +158,6 @@ impl<const D: usize> DualDomain<D> {
                     });
                     self.average[j * stride + corner_offset::<D>(a, b)] += integral;
                 }
-            }
-        }
-        for (j, &volume) in self.volume.iter().enumerate() {
-            let scale = if volume > 0.0 { 1.0 / volume } else { 0.0 };
-            for g in &mut self.average[j * stride..(j + 1) * stride] {
-                *g *= scale;
             }
         }
     }
@@ -220,6 +276,18 @@ mod tests {
         })
     }
 
+    /// The integrals of `integrals` over particles at `positions` with volumes `volumes`.
+    fn integrated<const D: usize>(
+        g: &Grid<D>,
+        integrals: DualIntegrals,
+        positions: &[SVector<f64, D>],
+        volumes: &[f64],
+    ) -> DualDomain<D> {
+        let mut dual = DualDomain::new(g, integrals);
+        dual.integrate(g, positions, volumes, &cells_of(g, positions));
+        dual
+    }
+
     /// The flat index of each point's cell.
     fn cells_of<const D: usize>(g: &Grid<D>, positions: &[SVector<f64, D>]) -> Vec<usize> {
         positions
@@ -243,18 +311,21 @@ mod tests {
             .collect()
     }
 
-    /// Random particles in [0, 0.6]^D (the cells beyond 2/3 empty) and random points. Where
-    /// every corner of the point's cell has material, sum_i grad S~_i = 0 and
-    /// sum_i x_i (x) grad S~_i = I; where some has none, the second is the sum of the corners'
-    /// S_j that have material, times I.
-    fn check_consistency<const D: usize>() {
+    /// Random particles with random volumes in [0, 0.6]^D (the cells beyond 2/3 empty) and
+    /// random points, for both integrals. Where every corner of the point's cell has material,
+    /// sum_i grad S~_i = 0 and sum_i x_i (x) grad S~_i = I; where some has none, the second is
+    /// the sum of the corners' S_j that have material, times I.
+    fn check_consistency<const D: usize>(integrals: DualIntegrals) {
         let g = grid::<D>(6);
         let mut rng = Lcg::new(2011);
         let positions: Vec<SVector<f64, D>> = (0..300 * D)
             .map(|_| SVector::from_fn(|_, _| 0.6 * rng.unit()))
             .collect();
-        let mut dual = DualDomain::new(&g);
-        dual.integrate(&g, &cells_of(&g, &positions));
+        let volumes: Vec<f64> = positions
+            .iter()
+            .map(|_| 1e-3 * (0.5 + rng.unit()))
+            .collect();
+        let dual = integrated(&g, integrals, &positions, &volumes);
         let (mut filled, mut partial) = (0, 0);
         let points = (0..500).map(|_| SVector::from_fn(|_, _| rng.unit()));
         for x in positions.iter().copied().chain(points) {
@@ -291,17 +362,19 @@ mod tests {
 
     #[test]
     fn dual_domain_gradient_is_consistent_where_there_is_material_1d() {
-        check_consistency::<1>();
+        check_consistency::<1>(DualIntegrals::Particles);
+        check_consistency::<1>(DualIntegrals::ActiveCells);
     }
 
     #[test]
     fn dual_domain_gradient_is_consistent_where_there_is_material_2d() {
-        check_consistency::<2>();
+        check_consistency::<2>(DualIntegrals::Particles);
+        check_consistency::<2>(DualIntegrals::ActiveCells);
     }
 
-    /// `ppc` particles per cell and axis at the centres of equal sub-cells (the seeding):
-    /// every cell active.
-    fn uniform<const D: usize>(g: &Grid<D>, ppc: usize) -> DualDomain<D> {
+    /// `ppc` particles per cell and axis at the centres of equal sub-cells (the seeding), each
+    /// with its sub-cell's volume: every cell active, the grid uniformly filled.
+    fn uniform<const D: usize>(g: &Grid<D>, ppc: usize, integrals: DualIntegrals) -> DualDomain<D> {
         let per_axis = [g.cells * ppc; D];
         let spacing = g.h / ppc as f64;
         let positions: Vec<SVector<f64, D>> = (0..per_axis[0].pow(D as u32))
@@ -310,9 +383,8 @@ mod tests {
                 SVector::from_fn(|k, _| (m[k] as f64 + 0.5) * spacing)
             })
             .collect();
-        let mut dual = DualDomain::new(g);
-        dual.integrate(g, &cells_of(g, &positions));
-        dual
+        let volumes = vec![spacing.powi(D as i32); positions.len()];
+        integrated(g, integrals, &positions, &volumes)
     }
 
     /// Wherever the particles sit, a grid with a particle in every cell has the integrals of
@@ -321,7 +393,7 @@ mod tests {
     #[test]
     fn integrals_depend_only_on_the_active_cells() {
         let g = grid::<2>(5);
-        let reference = uniform(&g, 2);
+        let reference = uniform(&g, 2, DualIntegrals::ActiveCells);
         let mut rng = Lcg::new(9);
         let mut positions: Vec<SVector<f64, 2>> = (0..25)
             .map(|c| {
@@ -330,19 +402,25 @@ mod tests {
             })
             .collect();
         positions.extend((0..40).map(|_| SVector::from_fn(|_, _| rng.unit())));
-        let mut dual = DualDomain::new(&g);
-        dual.integrate(&g, &cells_of(&g, &positions));
+        let volumes = vec![1.0; positions.len()];
+        let dual = integrated(&g, DualIntegrals::ActiveCells, &positions, &volumes);
         assert_eq!(dual.volume, reference.volume);
         assert_eq!(dual.average, reference.average);
     }
 
     /// 1D, uniformly filled: the modified gradient of a nodal field u is the hat
     /// interpolation of the nodal central differences (u_{j+1} - u_{j-1})/(2h), one-sided
-    /// (u_1 - u_0)/h and (u_n - u_{n-1})/h at the end nodes, whose dual domain is a half cell.
+    /// (u_1 - u_0)/h and (u_n - u_{n-1})/h at the end nodes, whose dual domain is a half cell,
+    /// with either integrals (in 1D the midpoint rule integrates N_j grad N_i exactly).
     #[test]
     fn uniform_fill_interpolates_central_differences_1d() {
         let g = grid::<1>(8);
-        let dual = uniform(&g, 2);
+        for integrals in [DualIntegrals::Particles, DualIntegrals::ActiveCells] {
+            check_central_differences_1d(&g, &uniform(&g, 2, integrals));
+        }
+    }
+
+    fn check_central_differences_1d(g: &Grid<1>, dual: &DualDomain<1>) {
         let mut rng = Lcg::new(5);
         let u: Vec<f64> = (0..=g.cells).map(|_| rng.unit() - 0.5).collect();
         let n = g.cells;
@@ -355,7 +433,7 @@ mod tests {
             .map(|_| SVector::<f64, 1>::new(rng.unit()))
             .chain([SVector::<f64, 1>::new(0.0), SVector::<f64, 1>::new(1.0)])
         {
-            let entries = basis_at(&dual, &g, &x);
+            let entries = basis_at(dual, g, &x);
             let du: f64 = entries.iter().map(|(i, _, gr)| u[*i] * gr[0]).sum();
             let expected: f64 = entries.iter().map(|(j, s, _)| s * nodal(*j)).sum();
             assert!((du - expected).abs() < 1e-12, "{x:?}: {du} vs {expected}");
@@ -364,21 +442,34 @@ mod tests {
 
     /// 2D, uniformly filled, at cells whose corners are interior nodes: the x-derivative is
     /// the hat interpolation of central differences along x averaged across y with the
-    /// weights int N_j N_{j+d} dy / int N_j dy = 1/6, 2/3, 1/6 for d = -1, 0, 1 (particle
-    /// sums, a midpoint rule, would give 1/6 + 1/(12 n^2), ... with n points per cell).
+    /// weights int N_j N_{j+d} dy / int N_j dy, d = -1, 0, 1: exactly 1/6, 2/3, 1/6 over the
+    /// active cells, and from the particle sums (a midpoint rule with n points per cell)
+    /// 1/6 + 1/(12 n^2), 2/3 - 1/(6 n^2), 1/6 + 1/(12 n^2).
     #[test]
     fn uniform_fill_averages_central_differences_2d() {
         let g = grid::<2>(6);
         let ppc = 2;
-        let dual = uniform(&g, ppc);
-        let across = [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0];
+        let side = 1.0 / (12.0 * (ppc * ppc) as f64);
+        check_central_differences_2d(
+            &g,
+            &uniform(&g, ppc, DualIntegrals::Particles),
+            [1.0 / 6.0 + side, 2.0 / 3.0 - 2.0 * side, 1.0 / 6.0 + side],
+        );
+        check_central_differences_2d(
+            &g,
+            &uniform(&g, ppc, DualIntegrals::ActiveCells),
+            [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+        );
+    }
+
+    fn check_central_differences_2d(g: &Grid<2>, dual: &DualDomain<2>, across: [f64; 3]) {
         let mut rng = Lcg::new(6);
         let u: Vec<f64> = (0..g.num_nodes()).map(|_| rng.unit() - 0.5).collect();
         let at = |i: usize, j: usize| u[g.node_index([i, j])];
         for _ in 0..300 {
             // Inside cells 1 .. cells - 2 along both axes.
             let x = SVector::<f64, 2>::from_fn(|_, _| (1.0 + 4.0 * rng.unit()) * g.h);
-            let entries = basis_at(&dual, &g, &x);
+            let entries = basis_at(dual, g, &x);
             let du: SVector<f64, 2> = entries.iter().map(|(i, _, gr)| gr * u[*i]).sum();
             let mut expected = SVector::<f64, 2>::zeros();
             for (node, s, _) in entries.iter().filter(|e| e.1 > 0.0) {

@@ -13,7 +13,7 @@ use nalgebra::SVector;
 
 pub use bspline::QuadraticBSpline;
 pub use domain::{DomainFault, DomainShape, ParticleDomains};
-pub use dual_domain::DualDomain;
+pub use dual_domain::{DualDomain, DualIntegrals};
 pub use grid::{lattice_coords, lattice_strides, Dofs, Grid};
 pub use linear::LinearHat;
 pub use lme::{

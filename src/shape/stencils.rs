@@ -44,6 +44,24 @@ impl<const D: usize> Stencils<D> {
         Ok(())
     }
 
+    /// The number of points whose stencils are stored.
+    pub fn points(&self) -> usize {
+        self.weight.len() / self.per_point.max(1)
+    }
+
+    /// The largest distance between two node numbers in one point's stencil: the
+    /// sub-diagonals of a matrix assembled from products N_i N_j at these points.
+    pub fn bandwidth(&self) -> usize {
+        self.node
+            .chunks_exact(self.per_point.max(1))
+            .map(|nodes| {
+                let (lo, hi) = (nodes.iter().min(), nodes.iter().max());
+                lo.zip(hi).map_or(0, |(lo, hi)| (hi - lo) as usize)
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Entries of particle `p`: (node, N, grad N).
     #[inline]
     pub fn of(&self, p: usize) -> impl Iterator<Item = (usize, f64, &SVector<f64, D>)> {

@@ -6,8 +6,8 @@ use crate::integrate::{self, Divergence, FixedDof};
 use crate::methods::TransferKind;
 use crate::particles::Particles;
 use crate::reconstruct::{
-    particles_to_grid, remap_velocity, FitStats, GridState, Lattice, QuadratureTransfer,
-    Reconstructor, TaylorTransfer,
+    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, GridState, Lattice,
+    QuadratureTransfer, Reconstructor, TaylorTransfer,
 };
 use crate::shape::{Grid, Shape, Stencils};
 
@@ -16,6 +16,8 @@ pub enum Transfer<const D: usize> {
     Quadrature(Box<QuadratureTransfer<D>>),
     /// The Shepard transfer with the nodal velocity replaced by this fit at the nodes.
     FittedVelocity(Box<Reconstructor<D>>),
+    /// The Shepard sums solved with the consistent mass matrix.
+    ConsistentMass(Box<ConsistentMassTransfer<D>>),
     /// Taylor least squares per element with its own mass matrix.
     Taylor(Box<TaylorTransfer<D>>),
 }
@@ -31,6 +33,9 @@ impl<const D: usize> Transfer<D> {
     ) -> Self {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
+            TransferKind::ConsistentMass => Transfer::ConsistentMass(Box::new(
+                ConsistentMassTransfer::new(grid.num_nodes(), fixed),
+            )),
             TransferKind::Quadrature(recipe) => {
                 Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid)))
             }
@@ -67,6 +72,9 @@ impl<const D: usize> Transfer<D> {
                 fit.apply(&particles.v, &mut grid.velocity);
                 Ok(stats)
             }
+            Transfer::ConsistentMass(cm) => cm
+                .map_to_grid(stencils, particles, body_force, grid)
+                .map(|()| FitStats::default()),
             Transfer::Taylor(tls) => tls.map_to_grid(stencils, particles, body_force, grid),
         }
     }
@@ -83,6 +91,7 @@ impl<const D: usize> Transfer<D> {
     pub fn solve_grid(&mut self, grid: &mut GridState<D>, fixed: &[FixedDof], kick: f64) {
         match self {
             Transfer::Taylor(tls) => tls.solve_grid(grid, kick),
+            Transfer::ConsistentMass(cm) => cm.solve_grid(grid, kick),
             _ => integrate::solve_grid(grid, fixed, kick),
         }
     }
@@ -93,6 +102,7 @@ impl<const D: usize> Transfer<D> {
     pub fn received_momentum(&self, mass: &[f64], velocity: &[SVector<f64, D>]) -> SVector<f64, D> {
         match self {
             Transfer::Taylor(tls) => tls.momentum_total(),
+            Transfer::ConsistentMass(cm) => cm.momentum_total(),
             _ => mass.iter().zip(velocity).map(|(&m, v)| v * m).sum(),
         }
     }
@@ -110,6 +120,7 @@ impl<const D: usize> Transfer<D> {
             Transfer::Shepard => remap_velocity(stencils, particles, grid, out),
             Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
             Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
+            Transfer::ConsistentMass(cm) => cm.remap_velocity(stencils, particles, grid, out),
             Transfer::Taylor(tls) => tls.remap_velocity(particles, grid, out),
         }
     }
