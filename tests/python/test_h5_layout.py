@@ -69,8 +69,8 @@ MASS_UNITS = "kg"
 REFERENCE_METHODS = ("ulfem",)
 # Methods whose mappings conserve mass and momentum to round-off.
 CONSERVATIVE_METHODS = (
-    "mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped", "bsmpm", "bsmpm_tls", "ddmpm", "ddmpm_tls",
-    "ddmpm_tls_lumped",
+    "mpm", "mpm_musl", "mpm_tls", "mpm_tls_lumped", "bsmpm", "bsmpm_consistent", "bsmpm_tls",
+    "bsmpm_tls_lumped", "ddmpm", "ddmpm_cells", "ddmpm_tls", "ddmpm_tls_lumped",
 )
 DIAGNOSTICS = ("reconstructions", "rank_deficient", "grid_crossings", "lme_failures")
 
