@@ -6,8 +6,8 @@ use std::fmt;
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
 use crate::params::{get_f64, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{
-    BodyForceFit, Degree, Kernel, MassMatrix, QuadratureRecipe, Recipe, Solver, TaylorRecipe,
-    Weight,
+    BodyForceFit, Degree, Kernel, MassMatrix, NodalVelocity, QuadratureRecipe, Recipe, Solver,
+    TaylorRecipe, Weight,
 };
 use crate::shape::{DomainShape, DualIntegrals, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
 
@@ -193,13 +193,23 @@ const fn recipe(weight: Weight, scale: f64, solver: Solver) -> Recipe {
     }
 }
 
+/// Gong sec 5.3, eq 5.6: the nodal velocity by linear MLS with the cubic spline.
+const IMPM_VELOCITY: Recipe = recipe(Weight::CubicSpline, 1.0, Solver::Mls);
+
 /// Gong sec 5.3: velocity by linear MLS with the cubic spline, density, stress and body
 /// force by linear MLS with the quadratic spline at the cell centres.
 const IMPM: QuadratureRecipe = QuadratureRecipe {
-    velocity: recipe(Weight::CubicSpline, 1.0, Solver::Mls),
+    velocity: NodalVelocity::Fit(IMPM_VELOCITY),
     fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Mls),
     gauss_points: 1,
     body_force: BodyForceFit::Separate,
+};
+
+/// IMPM's field fits and cell-centre quadrature (Gong eqs 5.7-5.14) with the original MPM's
+/// mass-weighted nodal velocity in place of eq 5.6: the field half of IMPM alone.
+const IMPM_FIELDS: QuadratureRecipe = QuadratureRecipe {
+    velocity: NodalVelocity::Shepard,
+    ..IMPM
 };
 
 /// Tran eqs 24-31: velocity by IMLS with the hat weight, density, stress and body force by
@@ -207,7 +217,7 @@ const IMPM: QuadratureRecipe = QuadratureRecipe {
 /// N_i times a linear field exactly. The quadratic spline is scaled with h as Gong does;
 /// `imls_eq27` scales it with 2h as Tran's eq 27 prints.
 const IMLS: QuadratureRecipe = QuadratureRecipe {
-    velocity: recipe(Weight::Hat, 1.0, Solver::Imls),
+    velocity: NodalVelocity::Fit(recipe(Weight::Hat, 1.0, Solver::Imls)),
     fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Imls),
     gauss_points: 2,
     body_force: BodyForceFit::Separate,
@@ -296,6 +306,30 @@ const PRESETS: &[MethodPreset] = &[
         },
         source: "Gong 2015, ch. 5",
         description: "improved MPM: MLS velocity at nodes, MLS density/stress at cell centres",
+    },
+    MethodPreset {
+        name: "impm_velocity_only",
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::FittedVelocity(IMPM_VELOCITY),
+            integrator: IntegratorKind::Leapfrog,
+            sampled_velocity: SampledVelocity::Stepped,
+        },
+        source: "Gong 2015, sec 5.3 (eq 5.6 alone), to isolate IMPM's parts",
+        description: "IMPM's MLS nodal velocity alone: mass and forces lumped at the particles as \
+                      in mpm, leapfrog",
+    },
+    MethodPreset {
+        name: "impm_fields_only",
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::Quadrature(IMPM_FIELDS),
+            integrator: IntegratorKind::Leapfrog,
+            sampled_velocity: SampledVelocity::Stepped,
+        },
+        source: "Gong 2015, sec 5.3 (eqs 5.7-5.14 alone), to isolate IMPM's parts",
+        description: "IMPM's MLS density/stress at cell centres alone: the nodal velocity the \
+                      mass-weighted average of mpm, leapfrog",
     },
     MethodPreset {
         name: "imls",
@@ -397,7 +431,7 @@ const PRESETS: &[MethodPreset] = &[
         name: "cpdi_mls",
         method: on_domains(
             DomainShape::Quadrilateral,
-            TransferKind::FittedVelocity(IMPM.velocity),
+            TransferKind::FittedVelocity(IMPM_VELOCITY),
             IntegratorKind::Leapfrog,
         ),
         source: "Gong 2015, sec 6.6 (improved CPDI)",

@@ -1307,7 +1307,7 @@ matrix:
         6,
         36,
         "matrix[1].gauss_points[0]",
-        "quadrature transfers only (impm, imls,",
+        "quadrature transfers only (impm, impm_fields_only, imls,",
         &[],
     );
     let e = error(&text.replace("gauss_points: [1, 2]", "gauss_points: [0, 2]"));

@@ -151,7 +151,13 @@ mod tests {
             assert_eq!(a, b, "the remap of unchanged velocities is the mapping");
         }
         let mut lumped_remap = vec![SVector::zeros(); grid.num_nodes()];
-        remap_velocity(&stencils, &particles, &lumped, &mut lumped_remap);
+        remap_velocity(
+            &stencils,
+            &particles,
+            &lumped.mass,
+            lumped.empty_mass,
+            &mut lumped_remap,
+        );
         assert_eq!(lumped_remap, lumped.velocity);
         (
             lumped.mass.clone(),

@@ -1,12 +1,14 @@
 //! Transfers that reconstruct fields instead of lumping particle data (IMPM, Gong sec 5.3;
 //! IMLS-MPM, Tran eqs 24-31): the nodal velocity is a least-squares fit of the particle
-//! velocities evaluated at the nodes; density, stress and body force are fitted and
-//! evaluated at quadrature points, where the nodal masses and forces are integrated.
+//! velocities evaluated at the nodes (or the original MPM's mass-weighted average, to isolate
+//! the field fits); density, stress and body force are fitted and evaluated at quadrature
+//! points, where the nodal masses and forces are integrated.
 
 use std::fmt;
 
 use nalgebra::{SMatrix, SVector};
 
+use super::shepard::{map_velocity, remap_velocity};
 use super::{FitStats, GridState, Lattice, Recipe, Reconstructor, SingularMoments};
 use crate::particles::Particles;
 use crate::shape::{Grid, LinearHat, Shape, Stencils};
@@ -14,8 +16,9 @@ use crate::shape::{Grid, LinearHat, Shape, Stencils};
 /// The parts of a quadrature transfer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadratureRecipe {
-    /// Fit of the particle velocities, evaluated at the nodes (Gong eq 5.6, Tran eq 31).
-    pub velocity: Recipe,
+    /// How the nodal velocity is made: a fit of the particle velocities evaluated at the
+    /// nodes (Gong eq 5.6, Tran eq 31), or the original MPM's average.
+    pub velocity: NodalVelocity,
     /// Fit of density, stress and body force, evaluated at the quadrature points (Gong eqs
     /// 5.7-5.8, Tran eqs 24-26).
     pub fields: Recipe,
@@ -23,6 +26,26 @@ pub struct QuadratureRecipe {
     pub gauss_points: usize,
     /// How the body-force term rho b is fitted at the quadrature points.
     pub body_force: BodyForceFit,
+}
+
+/// The nodal velocity of a quadrature transfer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NodalVelocity {
+    /// A least-squares fit of the particle velocities evaluated at the nodes.
+    Fit(Recipe),
+    /// v_i = sum_p M_p v_p N_ip / sum_p M_p N_ip with the run's basis at the particles, the
+    /// original MPM's mapping (Gong sec 4.3.1); the nodal mass that divides it is the Shepard
+    /// one, not the mass integrated from the fitted density.
+    Shepard,
+}
+
+impl fmt::Display for NodalVelocity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NodalVelocity::Fit(recipe) => write!(f, "{recipe}"),
+            NodalVelocity::Shepard => f.write_str("shepard"),
+        }
+    }
 }
 
 /// The fit behind the body-force term sum_g N_ig (rho b)_g omega_g.
@@ -53,8 +76,16 @@ impl BodyForceFit {
     }
 }
 
+/// The nodal velocity of a quadrature transfer as it is computed.
+enum VelocityMap<const D: usize> {
+    Fit(Box<Reconstructor<D>>),
+    /// With the Shepard masses sum_p M_p N_ip of the last mapping, which MUSL's remap
+    /// divides by.
+    Shepard(Vec<f64>),
+}
+
 pub struct QuadratureTransfer<const D: usize> {
-    velocity: Reconstructor<D>,
+    velocity: VelocityMap<D>,
     fields: Reconstructor<D>,
     /// N_i and grad N_i of the grid's hat at the quadrature points (whatever basis the
     /// particles use): fixed, because the grid is reset each step.
@@ -81,7 +112,12 @@ impl<const D: usize> QuadratureTransfer<D> {
             .update(&LinearHat, grid, &positions)
             .expect("quadrature points lie inside their cells");
         QuadratureTransfer {
-            velocity: Reconstructor::new(recipe.velocity, Lattice::nodes(grid)),
+            velocity: match recipe.velocity {
+                NodalVelocity::Fit(fit) => {
+                    VelocityMap::Fit(Box::new(Reconstructor::new(fit, Lattice::nodes(grid))))
+                }
+                NodalVelocity::Shepard => VelocityMap::Shepard(Vec::new()),
+            },
             fields: Reconstructor::new(recipe.fields, points),
             basis,
             weights,
@@ -94,20 +130,32 @@ impl<const D: usize> QuadratureTransfer<D> {
         }
     }
 
-    /// Nodal velocity by the velocity fit; m_i = sum_g N_ig rho_g omega_g and
+    /// Nodal velocity by the velocity fit, or the Shepard average with the particles' basis
+    /// `stencils`; m_i = sum_g N_ig rho_g omega_g and
     /// f_i = sum_g (N_ig (rho b)_g - sigma_g grad N_ig) omega_g (Gong eqs 5.9-5.14 with the
     /// cell volume, Tran eqs 28-30 with rho_g in the body-force term), (rho b)_g = rho_g b_g
     /// or the fit of rho_p b_p. Sums run in a fixed order. Returns the fit counters of this
     /// step.
     pub fn map_to_grid(
         &mut self,
+        stencils: &Stencils<D>,
         particles: &Particles<D>,
         body_force: &[SVector<f64, D>],
         grid: &mut GridState<D>,
     ) -> Result<FitStats, SingularMoments> {
-        grid.clear();
-        let mut stats = self.velocity.fit(&particles.x)?;
-        self.velocity.apply(&particles.v, &mut grid.velocity);
+        let mut stats = FitStats::default();
+        match &mut self.velocity {
+            VelocityMap::Fit(fit) => {
+                grid.clear();
+                stats += fit.fit(&particles.x)?;
+                fit.apply(&particles.v, &mut grid.velocity);
+            }
+            VelocityMap::Shepard(mass) => {
+                map_velocity(stencils, &particles.mass, &particles.v, grid);
+                mass.clone_from(&grid.mass);
+                grid.mass.fill(0.0);
+            }
+        }
         stats += self.fields.fit(&particles.x)?;
         self.particle_density.clear();
         self.particle_density
@@ -142,9 +190,21 @@ impl<const D: usize> QuadratureTransfer<D> {
         Ok(stats)
     }
 
-    /// The velocity fit of this step applied to other particle velocities (Tran eq 36).
-    pub fn remap_velocity(&self, v: &[SVector<f64, D>], out: &mut [SVector<f64, D>]) {
-        self.velocity.apply(v, out);
+    /// The velocity fit of this step applied to the particle velocities now (Tran eq 36), or
+    /// their Shepard average with this step's weights and Shepard masses.
+    pub fn remap_velocity(
+        &self,
+        stencils: &Stencils<D>,
+        particles: &Particles<D>,
+        empty_mass: f64,
+        out: &mut [SVector<f64, D>],
+    ) {
+        match &self.velocity {
+            VelocityMap::Fit(fit) => fit.apply(&particles.v, out),
+            VelocityMap::Shepard(mass) => {
+                remap_velocity(stencils, particles, mass, empty_mass, out)
+            }
+        }
     }
 }
 
@@ -166,6 +226,7 @@ mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem};
     use crate::methods;
+    use crate::reconstruct::particles_to_grid;
 
     fn recipes() -> Vec<QuadratureRecipe> {
         methods::presets()
@@ -175,6 +236,12 @@ mod tests {
                 _ => None,
             })
             .collect()
+    }
+
+    fn hat_stencils<const D: usize>(grid: &Grid<D>, x: &[SVector<f64, D>]) -> Stencils<D> {
+        let mut stencils = Stencils::new(Shape::<D>::nodes_per_point(&LinearHat), x.len());
+        stencils.update(&LinearHat, grid, x).unwrap();
+        stencils
     }
 
     /// Uniform density on a covered domain: the fits reproduce constants, so the grid mass
@@ -192,10 +259,13 @@ mod tests {
         let b = SVector::<f64, D>::from_fn(|k, _| 1.0 - 3.0 * k as f64);
         let body = vec![b; particles.len()];
         let total: f64 = particles.mass.iter().sum();
+        let stencils = hat_stencils(&grid, &particles.x);
         for recipe in recipes() {
             let mut transfer = QuadratureTransfer::new(&recipe, &grid);
             let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
-            let stats = transfer.map_to_grid(&particles, &body, &mut nodes).unwrap();
+            let stats = transfer
+                .map_to_grid(&stencils, &particles, &body, &mut nodes)
+                .unwrap();
             assert_eq!(stats.rank_deficient, 0);
             let mass: f64 = nodes.mass.iter().sum();
             assert!(
@@ -218,6 +288,205 @@ mod tests {
     #[test]
     fn uniform_density_conserves_mass_and_balances_forces_2d() {
         check_balance::<2>();
+    }
+
+    fn preset_recipe(name: &str) -> QuadratureRecipe {
+        match methods::preset(name).unwrap().method.transfer {
+            crate::methods::TransferKind::Quadrature(r) => r,
+            other => panic!("{name} maps with {other}"),
+        }
+    }
+
+    /// The field half of IMPM alone (`impm_fields_only`) on scattered particles with varying
+    /// density: the nodal velocity is the original MPM's mass-weighted average and the nodal
+    /// masses and forces are IMPM's, to round-off; MUSL's remap divides by the Shepard masses,
+    /// which differ from the fitted ones.
+    fn check_shepard_velocity<const D: usize>() {
+        let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
+        let grid = Grid::new(&prob.domain());
+        let mut particles = Particles::seed(&prob, &grid);
+        let mut rng = crate::rng::Lcg::new(31);
+        for p in 0..particles.len() {
+            particles.x[p] += SVector::<f64, D>::from_fn(|_, _| 0.02 * (rng.unit() - 0.5));
+            particles.x[p] = particles.x[p].map(|c| c.clamp(0.0, 1.0));
+            particles.v[p] = SVector::from_fn(|_, _| rng.unit() - 0.5);
+            particles.stress[p] = SMatrix::from_fn(|_, _| 1e3 * (rng.unit() - 0.5));
+            particles.volume[p] *= 1.0 + 0.2 * (rng.unit() - 0.5);
+        }
+        let body = vec![SVector::<f64, D>::from_fn(|k, _| 2.0 - k as f64); particles.len()];
+        let stencils = hat_stencils(&grid, &particles.x);
+        let map = |nodes: &mut GridState<D>, recipe: Option<QuadratureRecipe>| {
+            let mut transfer = recipe.map(|r| QuadratureTransfer::new(&r, &grid));
+            match &mut transfer {
+                Some(t) => {
+                    t.map_to_grid(&stencils, &particles, &body, nodes).unwrap();
+                }
+                None => particles_to_grid(&stencils, &particles, &body, nodes),
+            }
+            transfer
+        };
+        let fresh = || GridState::new(grid.num_nodes(), particles.mass[0]);
+        let (mut mpm, mut impm, mut fields) = (fresh(), fresh(), fresh());
+        map(&mut mpm, None);
+        map(&mut impm, Some(preset_recipe("impm")));
+        let transfer = map(&mut fields, Some(preset_recipe("impm_fields_only"))).unwrap();
+        let largest = |a: &[SVector<f64, D>], b: &[SVector<f64, D>]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).norm())
+                .fold(0.0, f64::max)
+        };
+        assert!(largest(&fields.velocity, &mpm.velocity) < 1e-15);
+        assert!(largest(&fields.force, &impm.force) < 1e-15);
+        assert_eq!(fields.mass, impm.mass);
+        assert!(largest(&fields.velocity, &impm.velocity) > 1e-3);
+        let mut remapped = vec![SVector::zeros(); grid.num_nodes()];
+        transfer.remap_velocity(&stencils, &particles, fields.empty_mass, &mut remapped);
+        assert!(largest(&remapped, &mpm.velocity) < 1e-15);
+        let mass_gap = fields
+            .mass
+            .iter()
+            .zip(&mpm.mass)
+            .map(|(a, b)| (a - b).abs() / b)
+            .fold(0.0, f64::max);
+        assert!(
+            mass_gap > 1e-3,
+            "fitted and Shepard masses agree to {mass_gap:e}"
+        );
+    }
+
+    #[test]
+    fn the_shepard_velocity_is_mpms_and_the_fields_are_impms_1d() {
+        check_shepard_velocity::<1>();
+    }
+
+    #[test]
+    fn the_shepard_velocity_is_mpms_and_the_fields_are_impms_2d() {
+        check_shepard_velocity::<2>();
+    }
+
+    /// The O(h^2) constants C of IMPM's reconstructions on the undistorted seed lattice of
+    /// `mms1d_gong` (docs/NOTES.md, the isolation of IMPM's parts): at a point x_e in the
+    /// middle of the bar, u^h(x_e) = u(x_e) (1 - C (pi h)^2) for a mode u = sin(pi x) sampled at
+    /// the particles, sampled as the linear interpolant of its nodal values (what the leapfrog's
+    /// particle update leaves), or constant per cell (the particle stresses of a small
+    /// deformation), against the closed forms of the weights' lattice moments. Nodal velocity:
+    /// the Shepard average (`mpm`) and the cubic MLS (`impm`); fields at the cell centre: the
+    /// quadratic MLS; nodal body force sum_p M_p b_p N_ip (`mpm`) and IMPM's cell-centre rule,
+    /// over rho0 h.
+    #[test]
+    fn lattice_constants_of_the_impm_reconstructions() {
+        let impm = preset_recipe("impm");
+        let NodalVelocity::Fit(velocity_fit) = impm.velocity else {
+            panic!("impm fits its velocity");
+        };
+        let cells = 64;
+        for ppc in [2, 4] {
+            let prob = gong_mms::<1>(&thesis_params(1e-4, cells as i64, ppc as i64)).unwrap();
+            let grid = Grid::new(&prob.domain());
+            let particles = Particles::seed(&prob, &grid);
+            let h = grid.h;
+            let mode = |x: f64| (std::f64::consts::PI * x).sin();
+            let x: Vec<f64> = particles.x.iter().map(|x| x[0]).collect();
+            let node = cells / 2;
+            let centre = cells / 2;
+            let x_node = node as f64 * h;
+            let x_centre = (centre as f64 + 0.5) * h;
+            let sampled: Vec<f64> = x.iter().map(|&x| mode(x)).collect();
+            let interpolated: Vec<f64> = x
+                .iter()
+                .map(|&x| {
+                    let left = (x / h).floor();
+                    let xi = x / h - left;
+                    (1.0 - xi) * mode(left * h) + xi * mode((left + 1.0) * h)
+                })
+                .collect();
+            let per_cell: Vec<f64> = x
+                .iter()
+                .map(|&x| mode(((x / h).floor() + 0.5) * h))
+                .collect();
+            let stencils = hat_stencils(&grid, &particles.x);
+            let constant =
+                |value: f64, exact: f64| (1.0 - value / exact) / (std::f64::consts::PI * h).powi(2);
+            let shepard = |u: &[f64]| {
+                let v: Vec<SVector<f64, 1>> = u.iter().map(|&u| SVector::repeat(u)).collect();
+                let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
+                map_velocity(&stencils, &particles.mass, &v, &mut nodes);
+                constant(nodes.velocity[node][0], mode(x_node))
+            };
+            let fit = |recipe: Recipe, lattice: Lattice<1>, u: &[f64], e: usize, exact: f64| {
+                let mut fit = Reconstructor::new(recipe, lattice);
+                fit.fit(&particles.x).unwrap();
+                let mut out = vec![0.0; fit.lattice().len()];
+                fit.apply(u, &mut out);
+                constant(out[e], exact)
+            };
+            let nodes = || Lattice::nodes(&grid);
+            let centres = || Lattice::cell_centres(&grid);
+            let body = |recipe: Option<QuadratureRecipe>| {
+                let b: Vec<SVector<f64, 1>> = sampled.iter().map(|&b| SVector::repeat(b)).collect();
+                let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
+                match recipe {
+                    Some(r) => {
+                        QuadratureTransfer::new(&r, &grid)
+                            .map_to_grid(&stencils, &particles, &b, &mut nodes)
+                            .unwrap();
+                    }
+                    None => particles_to_grid(&stencils, &particles, &b, &mut nodes),
+                }
+                constant(nodes.force[node][0] / (prob.rho0() * h), mode(x_node))
+            };
+            // The closed forms: half the lattice moment sum_p w_p r_p^2 / sum_p w_p (r in
+            // cells) of the weight about the point (1/3 for the cubic and 1/4 for the
+            // quadratic spline, which these lattices sample exactly; 3/16 and 11/64 for the
+            // hat); the linear interpolant adds half the mean of xi (1 - xi) over the seed
+            // offsets xi; data constant per cell take the moment of the cell-centre distances;
+            // the cell-centre rule adds (1 - cos(pi h / 2)) / (pi h)^2 = 1/8 to the body force.
+            let (shepard_moment, interpolant) = match ppc {
+                2 => (3.0 / 32.0, 3.0 / 32.0),
+                _ => (11.0 / 128.0, 11.0 / 128.0),
+            };
+            let per_cell_fit = match ppc {
+                2 => 5.0 / 32.0,
+                _ => 21.0 / 128.0,
+            };
+            let checks = [
+                ("Shepard nodal velocity", shepard(&sampled), shepard_moment),
+                (
+                    "MLS nodal velocity",
+                    fit(velocity_fit, nodes(), &sampled, node, mode(x_node)),
+                    1.0 / 6.0,
+                ),
+                (
+                    "Shepard of the interpolant",
+                    shepard(&interpolated),
+                    shepard_moment + interpolant,
+                ),
+                (
+                    "MLS of the interpolant",
+                    fit(velocity_fit, nodes(), &interpolated, node, mode(x_node)),
+                    1.0 / 6.0 + interpolant,
+                ),
+                (
+                    "field fit at the cell centre",
+                    fit(impm.fields, centres(), &sampled, centre, mode(x_centre)),
+                    0.125,
+                ),
+                (
+                    "field fit of per-cell data",
+                    fit(impm.fields, centres(), &per_cell, centre, mode(x_centre)),
+                    per_cell_fit,
+                ),
+                ("MPM body force", body(None), shepard_moment),
+                ("IMPM body force", body(Some(impm)), 0.125 + 0.125),
+            ];
+            for (what, measured, expected) in checks {
+                assert!(
+                    (measured - expected).abs() < 2e-3 * expected,
+                    "ppc {ppc}, {what}: {measured} against {expected}"
+                );
+            }
+        }
     }
 
     /// One Gauss point per cell and axis is the cell centre, with the cell's volume as weight
@@ -270,10 +539,13 @@ mod tests {
             body_force,
             ..recipes().into_iter().find(|r| r.gauss_points == 2).unwrap()
         };
+        let stencils = hat_stencils(&grid, &particles.x);
         let force = |body_force| {
             let mut transfer = QuadratureTransfer::new(&recipe(body_force), &grid);
             let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
-            transfer.map_to_grid(&particles, &body, &mut nodes).unwrap();
+            transfer
+                .map_to_grid(&stencils, &particles, &body, &mut nodes)
+                .unwrap();
             nodes.force.iter().map(|f| f[0]).collect::<Vec<f64>>()
         };
         let largest = |f: &[f64]| {

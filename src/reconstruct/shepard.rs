@@ -81,15 +81,16 @@ pub fn nodal_forces<const D: usize>(
 }
 
 /// MUSL's v_i^L for the Shepard mapping: sum_p M_p v_p N_ip / m_i with this step's weights
-/// and nodal masses.
+/// and Shepard masses m_i = sum_p M_p N_ip (nodes at or below `empty_mass` left at rest).
 pub fn remap_velocity<const D: usize>(
     stencils: &Stencils<D>,
     particles: &Particles<D>,
-    grid: &GridState<D>,
+    mass: &[f64],
+    empty_mass: f64,
     out: &mut [SVector<f64, D>],
 ) {
     momentum_sums(stencils, particles, out);
-    momentum_to_velocity(out, &grid.mass, grid.empty_mass);
+    momentum_to_velocity(out, mass, empty_mass);
 }
 
 /// p_i = sum_p M_p v_p N_ip into `out`.

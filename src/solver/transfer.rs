@@ -62,7 +62,7 @@ impl<const D: usize> Transfer<D> {
                 Ok(FitStats::default())
             }
             Transfer::Quadrature(q) => q
-                .map_to_grid(particles, body_force, grid)
+                .map_to_grid(stencils, particles, body_force, grid)
                 .map_err(|e| Divergence::Reconstruction(e.to_string())),
             Transfer::FittedVelocity(fit) => {
                 particles_to_grid(stencils, particles, body_force, grid);
@@ -108,7 +108,8 @@ impl<const D: usize> Transfer<D> {
     }
 
     /// The nodal velocity rebuilt from the particle velocities `v` with this step's
-    /// weights (MUSL's v_i^L): mass-weighted for Shepard, the velocity fit otherwise.
+    /// weights (MUSL's v_i^L): mass-weighted for Shepard (and a quadrature transfer with the
+    /// Shepard velocity), the velocity fit otherwise.
     pub fn remap_velocity(
         &mut self,
         stencils: &Stencils<D>,
@@ -117,8 +118,10 @@ impl<const D: usize> Transfer<D> {
         out: &mut [SVector<f64, D>],
     ) {
         match self {
-            Transfer::Shepard => remap_velocity(stencils, particles, grid, out),
-            Transfer::Quadrature(q) => q.remap_velocity(&particles.v, out),
+            Transfer::Shepard => {
+                remap_velocity(stencils, particles, &grid.mass, grid.empty_mass, out)
+            }
+            Transfer::Quadrature(q) => q.remap_velocity(stencils, particles, grid.empty_mass, out),
             Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
             Transfer::ConsistentMass(cm) => cm.remap_velocity(stencils, particles, grid, out),
             Transfer::Taylor(tls) => tls.remap_velocity(particles, grid, out),
