@@ -575,6 +575,23 @@ mod tests {
     use nalgebra::SMatrix;
     use std::path::Path;
 
+    /// Steps 1-2 of a step at time `t`: locate, the stencils, the body force, the mapping and
+    /// the grid solve with a whole kick dt.
+    fn grid_step(run: &mut Run<1>, t: f64, dt: f64) {
+        run.locate_particles().unwrap();
+        run.update_stencils().unwrap();
+        run.problem.body_force(t, &mut run.body_force);
+        run.transfer
+            .map_to_grid(
+                &run.stencils,
+                &run.particles,
+                &run.body_force,
+                &mut run.nodes,
+            )
+            .unwrap();
+        run.transfer.solve_grid(&mut run.nodes, &run.fixed, dt);
+    }
+
     /// The second step of `mpm` on Tran's bar with `integrator`, taken piece by piece: the
     /// particles' F after it, and I + dt sum_i v_i (x) grad N_ip with the nodal velocity the
     /// grid solve produced and the start-of-step stencils.
@@ -591,20 +608,7 @@ mod tests {
         };
         let mut run = Run::new(spec, method, problem);
         let dt = run.problem.dt();
-        let grid_solve = |run: &mut Run<1>, s: usize| {
-            run.locate_particles().unwrap();
-            run.update_stencils().unwrap();
-            run.problem.body_force(s as f64 * dt, &mut run.body_force);
-            run.transfer
-                .map_to_grid(
-                    &run.stencils,
-                    &run.particles,
-                    &run.body_force,
-                    &mut run.nodes,
-                )
-                .unwrap();
-            run.transfer.solve_grid(&mut run.nodes, &run.fixed, dt);
-        };
+        let grid_solve = |run: &mut Run<1>, s: usize| grid_step(run, s as f64 * dt, dt);
         // At t = 0 the stress and the body force vanish, so every integrator agrees; the
         // second step is compared.
         grid_solve(&mut run, 0);
@@ -680,17 +684,7 @@ mod tests {
             }
             let dt = run.problem.dt();
             for s in 0..40 {
-                run.locate_particles().unwrap();
-                run.update_stencils().unwrap();
-                run.transfer
-                    .map_to_grid(
-                        &run.stencils,
-                        &run.particles,
-                        &run.body_force,
-                        &mut run.nodes,
-                    )
-                    .unwrap();
-                run.transfer.solve_grid(&mut run.nodes, &run.fixed, dt);
+                grid_step(&mut run, s as f64 * dt, dt);
                 run.update_particles(dt, dt).unwrap();
                 let t = (s + 1) as f64 * dt;
                 for p in 0..run.particles.len() {
