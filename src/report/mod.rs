@@ -5,7 +5,7 @@
 //! errors are fitted against h as a power law per field and norm.
 
 mod check;
-mod figures;
+pub mod figures;
 mod fit;
 mod format;
 mod group;

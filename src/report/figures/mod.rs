@@ -12,9 +12,8 @@ use std::path::PathBuf;
 
 use super::group::{selects, slug};
 use crate::benchmarks::BenchmarkKind;
-use crate::experiment::{Experiment, FigureKind, FigureSpec};
+use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
 use crate::output::RunSummary;
-use crate::params::Params;
 
 /// How the axes of a figure are scaled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -96,7 +95,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
         fields: measures.fields.iter().map(|f| f.to_string()).collect(),
         norm: measures.norms[0].to_string(),
         by: Vec::new(),
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         probe: None,
     }];
