@@ -14,6 +14,7 @@ mod plot;
 mod pointwise;
 mod probe_table;
 pub mod stability;
+mod style;
 mod tables;
 
 use std::fs;
