@@ -284,6 +284,43 @@ fn expect_selector_must_be_a_value_of_its_axis() {
 }
 
 #[test]
+fn selectors_may_list_values_each_checked_where_written() {
+    let exp = parse(&edited("{G: 0.1, field", "{G: [0.1, 1.0e-4], field")).unwrap();
+    let g = exp.expect[1].select.get("G").unwrap();
+    assert_eq!(
+        g.values(),
+        [ParamValue::Float(0.1), ParamValue::Float(1e-4)]
+    );
+    let e = error(&edited("{G: 0.1, field", "{G: [0.1, 0.2], field"));
+    check(
+        &e,
+        10,
+        15,
+        "expect[1].G[1]",
+        "no run has G = 0.2",
+        &["0.0001", "0.1"],
+    );
+    let e = error(&edited("{G: 0.1, field", "{G: [], field"));
+    check(
+        &e,
+        10,
+        9,
+        "expect[1].G",
+        "an empty list selects no run",
+        &["0.0001", "0.1"],
+    );
+    let e = error(&edited("{G: 0.1, field", "{G: [0.1, 1.0e-1], field"));
+    check(
+        &e,
+        10,
+        15,
+        "expect[1].G[1]",
+        "0.1 is listed twice (first as expect[1].G[0])",
+        &[],
+    );
+}
+
+#[test]
 fn expect_entries_need_a_field_and_a_bound() {
     let e = error(&edited("field: stress, ", ""));
     check(
@@ -503,7 +540,8 @@ fn valid_file_expands_in_order_with_stable_ids() {
     assert_eq!(unique.len(), exp.runs.len());
 
     assert_eq!(exp.expect.len(), 2);
-    assert_eq!(exp.expect[0].select["G"], ParamValue::Float(1e-4));
+    let g = exp.expect[0].select.get("G").unwrap();
+    assert_eq!(g.values(), [ParamValue::Float(1e-4)]);
     assert_eq!((exp.expect[0].line, exp.expect[0].rate_min), (9, Some(1.8)));
     assert_eq!(
         (exp.expect[1].norm.as_str(), exp.expect[1].rate_max),

@@ -6,7 +6,8 @@ use std::path::Path;
 
 use mpmlab::benchmarks::BenchmarkKind;
 use mpmlab::experiment::{
-    Expectation, Experiment, FigureKind, FigureSpec, OutputSpec, ProbeWindow, TableKind, TableSpec,
+    Expectation, Experiment, FigureKind, FigureSpec, OutputSpec, ProbeWindow, Selection, TableKind,
+    TableSpec,
 };
 use mpmlab::output::{ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
@@ -123,7 +124,7 @@ fn experiment(expect: Vec<Expectation>, figures: Vec<FigureSpec>) -> Experiment 
 
 fn expect(line: usize, select: &[(&str, &str)], field: &str) -> Expectation {
     Expectation {
-        select: params(select),
+        select: Selection::from(&params(select)),
         field: field.into(),
         norm: "l2".into(),
         rate_min: None,
@@ -338,7 +339,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         fields: vec!["velocity".into(), "stress".into()],
         norm: "rms".into(),
         by: vec!["G".into()],
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         probe: None,
     };
@@ -431,7 +432,7 @@ fn history(probe: &str) -> FigureSpec {
         fields: Vec::new(),
         norm: "l2".into(),
         by: vec!["method".into()],
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         probe: Some(probe.into()),
     }
@@ -463,7 +464,7 @@ fn probes_table(probe: &str) -> TableSpec {
     TableSpec {
         kind: TableKind::Probes,
         columns: None,
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         measure: None,
         probe: Some(ProbeWindow {
@@ -513,7 +514,7 @@ fn conservation_tables_list_each_runs_mapping_errors() {
     exp.tables = vec![TableSpec {
         kind: TableKind::Conservation,
         columns: None,
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         measure: None,
         probe: None,

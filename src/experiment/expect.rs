@@ -2,11 +2,10 @@
 //! limits, for `report --check`.
 
 use crate::output::Measures;
-use crate::params::Params;
 
 use super::error::ConfigError;
 use super::measures::{error_field, norm};
-use super::select::selection;
+use super::select::{selection, Selection};
 use super::space::ParamSpace;
 use super::stability::sweep;
 use super::values::{finite, positive};
@@ -120,7 +119,7 @@ fn read_limit(
     parent: &str,
     entries: &[Entry],
     space: &ParamSpace,
-    select: Params,
+    select: Selection,
 ) -> Result<Expectation, ConfigError> {
     let sweep = sweep(entries, node, parent, space, &select)?;
     let bound = |key: &str| {

@@ -1,14 +1,12 @@
 //! What `figures` and `tables` items share: a required `kind`, one of a list and one whose
 //! data the benchmark's runs record, their own keys, and axis values selecting runs.
 
-use crate::benchmarks::BenchmarkKind;
-use crate::params::Params;
-
 use super::error::ConfigError;
-use super::select::selection;
+use super::select::{selection, Selection};
 use super::space::ParamSpace;
 use super::values::pick;
 use super::yaml::{child_field, read_list, require, Entry, Node};
+use crate::benchmarks::BenchmarkKind;
 
 /// Named kinds of a `what` (figure, table), the keys its items take besides axis values, which
 /// of them each kind takes, and which benchmarks record what each kind shows.
@@ -28,7 +26,7 @@ pub(crate) struct Item<'a, K: 'static> {
     pub parent: &'a str,
     pub entries: Vec<Entry<'a>>,
     pub kind: &'static K,
-    pub select: Params,
+    pub select: Selection,
 }
 
 impl<K> Kinds<K> {

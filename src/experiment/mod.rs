@@ -26,6 +26,7 @@ use crate::params::Params;
 
 pub use error::ConfigError;
 pub use expand::MAX_RUNS;
+pub use select::{Allowed, Selection};
 
 use document::Sections;
 use error::{Pos, FILE_FIELD};
@@ -139,8 +140,9 @@ pub struct RunSpec {
 /// One `expect` entry, checked by `mpmlab report --check`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expectation {
-    /// Matrix-axis values the entry applies to (e.g. method: mpm, G: 0.1); empty = all groups.
-    pub select: Params,
+    /// Matrix-axis values the entry applies to (e.g. method: [mpm, usl], G: 0.1); empty = all
+    /// groups.
+    pub select: Selection,
     pub field: String,
     pub norm: String,
     pub rate_min: Option<f64>,
@@ -209,8 +211,8 @@ pub struct FigureSpec {
     /// one at most, except for history figures, whose lines may differ in several (a method
     /// with a gamma axis beside methods without).
     pub by: Vec<String>,
-    /// Axis values a run must have to be drawn; empty = every run.
-    pub select: Params,
+    /// Axis values a run must have (one of those listed per axis) to be drawn; empty = every run.
+    pub select: Selection,
     /// Stability and growth figures only.
     pub stability: Option<StabilityAxes>,
     /// History figures only: the probe drawn (checked against the run files by the report).
@@ -245,8 +247,9 @@ pub struct TableSpec {
     pub kind: TableKind,
     /// Axis whose values become the columns of one table (others make separate tables).
     pub columns: Option<String>,
-    /// Axis values a run must have to be listed; empty = every run.
-    pub select: Params,
+    /// Axis values a run must have (one of those listed per axis) to be listed; empty = every
+    /// run.
+    pub select: Selection,
     /// Stability tables only.
     pub stability: Option<StabilityAxes>,
     /// Errors tables only: the (field, norm) listed.

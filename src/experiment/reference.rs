@@ -6,6 +6,7 @@ use crate::benchmarks::{BenchmarkInfo, BenchmarkKind};
 use crate::params::Params;
 
 use super::error::ConfigError;
+use super::select::listed;
 use super::space::ParamSpace;
 use super::values::normalize;
 use super::yaml::{child_field, Entry};
@@ -49,6 +50,17 @@ pub(crate) fn read(
                 )
                 .with_valid(space.axes().iter().map(|a| a.key.as_str()))
             })?;
+        if listed(axis.kind, e.value).is_some() {
+            return Err(ConfigError::at(
+                e.value.pos,
+                field,
+                format!(
+                    "the reference is one run: give one value of '{}', not a list",
+                    e.key
+                ),
+            )
+            .with_valid(space.axis_values(e.key)));
+        }
         let value = normalize(axis.kind, e.value, &field)?;
         select.insert(e.key.to_string(), value);
     }
@@ -86,4 +98,34 @@ pub(crate) fn check_unique(
             ids.join(", ")
         ),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::experiment::parse;
+
+    const BAR: &str = "\
+name: ref
+benchmark: vibrating_bar
+params: {exact: none, ppc: 2}
+matrix:
+  method: [mpm_musl, ulfem]
+  cells: [5, 10]
+reference: REFERENCE
+";
+
+    #[test]
+    fn the_reference_takes_one_value_per_axis() {
+        let read = |reference: &str| parse(&BAR.replace("REFERENCE", reference), Path::new("r"));
+        let exp = read("{method: ulfem, cells: 10}").unwrap();
+        assert_eq!(exp.reference.unwrap()["method"].to_string(), "ulfem");
+        let e = read("{method: [ulfem], cells: 10}").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "r:7:21: field 'reference.method': the reference is one run: give one value of \
+             'method', not a list (valid: mpm_musl, ulfem)"
+        );
+    }
 }

@@ -2,10 +2,8 @@
 //! axis along which runs are taken towards instability, and `x`, the axis whose values a
 //! stability figure puts on its abscissa and a stability table in its rows.
 
-use crate::params::Params;
-
 use super::error::{ConfigError, Pos};
-use super::select::axis_key;
+use super::select::{axis_key, Selection};
 use super::space::ParamSpace;
 use super::yaml::{child_field, require, Entry, Node};
 use super::StabilityAxes;
@@ -17,7 +15,7 @@ pub(crate) fn axes(
     node: &Node,
     parent: &str,
     space: &ParamSpace,
-    select: &Params,
+    select: &Selection,
     with_x: bool,
 ) -> Result<StabilityAxes, ConfigError> {
     let sweep = sweep(entries, node, parent, space, select)?;
@@ -43,10 +41,10 @@ pub(crate) fn sweep(
     node: &Node,
     parent: &str,
     space: &ParamSpace,
-    select: &Params,
+    select: &Selection,
 ) -> Result<String, ConfigError> {
     let (sweep, pos) = numeric_axis(entries, "sweep", node, parent, space)?;
-    if select.contains_key(&sweep) {
+    if select.get(&sweep).is_some() {
         return Err(ConfigError::at(
             pos,
             child_field(parent, "sweep"),

@@ -1,8 +1,10 @@
 //! Which runs belong together, in which order, and which of their errors can be fitted.
 
 use std::cmp::Ordering;
+use std::collections::BTreeMap;
+use std::fmt::Display;
 
-use crate::experiment::Experiment;
+use crate::experiment::{Experiment, Selection};
 use crate::output::{RunStatus, RunSummary};
 use crate::params::{ParamValue, Params};
 
@@ -61,7 +63,6 @@ fn without(axes: &Params, drop: &[&str]) -> Params {
         .collect()
 }
 
-/// `key=value` pairs sorted by key, space separated; empty when there are none.
 /// The run's value of each of the experiment's axes, in file order (empty if absent).
 pub fn axis_values<'a>(
     experiment: &'a Experiment,
@@ -75,11 +76,33 @@ pub fn axis_values<'a>(
     })
 }
 
-pub fn label(axes: &Params) -> String {
-    axes.iter()
+/// `key=value` pairs, space separated, in their order (by key for axes and selections; a
+/// selection's values read `a|b`); empty when there are none.
+pub fn label<K: Display, V: Display>(pairs: impl IntoIterator<Item = (K, V)>) -> String {
+    pairs
+        .into_iter()
         .map(|(k, v)| format!("{k}={v}"))
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+/// The label of a group of runs that `select` chose: the group's axis values, and for an axis
+/// that varies within the group (one the grouping dropped, a figure's `by`) the values
+/// `select` lists when it lists several, so that figures of two such selections tell
+/// themselves apart (`G=0.1 method=mpm_musl|mpm_tls`). A one-value selection adds nothing.
+pub fn scoped_label(group: &Params, select: &Selection) -> String {
+    let mut pairs: BTreeMap<&str, String> = group
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.to_string()))
+        .collect();
+    for (axis, allowed) in select {
+        if allowed.values().len() > 1 {
+            pairs
+                .entry(axis.as_str())
+                .or_insert_with(|| allowed.to_string());
+        }
+    }
+    label(pairs)
 }
 
 /// A group's label for titles and file names, `all` for a group without axes.
@@ -100,11 +123,12 @@ pub fn title_suffix(label: &str) -> String {
     }
 }
 
-/// Whether `axes` holds every key of `select` with the same value.
-pub fn selects(select: &Params, axes: &Params) -> bool {
-    select
-        .iter()
-        .all(|(k, v)| axes.get(k).is_some_and(|a| same_value(a, v)))
+/// Whether `axes` holds every axis of `select` with one of the values it allows.
+pub fn selects(select: &Selection, axes: &Params) -> bool {
+    select.iter().all(|(k, allowed)| {
+        axes.get(k)
+            .is_some_and(|a| allowed.values().iter().any(|v| same_value(a, v)))
+    })
 }
 
 /// `G: 1` in a selector should match an axis written `G: 1.0`, so numbers compare by value.
@@ -155,14 +179,18 @@ pub fn usable_points(runs: &[&RunSummary], field: &str, norm: &str) -> Vec<(f64,
         .collect()
 }
 
-/// A file-name-safe version of `text`: runs of characters outside `[A-Za-z0-9.-]` become one
-/// `_`, none at the ends (`points=[-0.6, 0.4]` gives `points_-0.6_0.4`).
+/// A file-name-safe version of `text`: the `|` between the values of a selection becomes `+`,
+/// other runs of characters outside `[A-Za-z0-9.-]` one `_`, none at the ends
+/// (`points=[-0.6, 0.4]` gives `points_-0.6_0.4`, `method=mpm|usl` `method_mpm+usl`).
 pub fn slug(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         if c.is_ascii_alphanumeric() || matches!(c, '.' | '-') {
             out.push(c);
-        } else if !out.is_empty() && !out.ends_with('_') {
+        } else if c == '|' {
+            out.truncate(out.trim_end_matches('_').len());
+            out.push('+');
+        } else if !out.is_empty() && !out.ends_with(['_', '+']) {
             out.push('_');
         }
     }
@@ -191,6 +219,15 @@ mod tests {
 
     fn one(key: &str, value: ParamValue) -> Params {
         Params::from([(key.to_string(), value)])
+    }
+
+    fn text(s: &str) -> ParamValue {
+        ParamValue::Str(s.into())
+    }
+
+    /// A selection of `key` with these values.
+    fn any_of(key: &str, values: Vec<ParamValue>) -> Selection {
+        Selection::from_iter([(key.to_string(), values.into())])
     }
 
     #[test]
@@ -223,13 +260,80 @@ mod tests {
             ("G".to_string(), ParamValue::Float(1.0)),
             ("method".to_string(), ParamValue::Str("mpm".into())),
         ]);
-        assert!(selects(&one("G", ParamValue::Int(1)), &axes));
-        assert!(selects(&Params::new(), &axes));
-        assert!(!selects(
-            &one("method", ParamValue::Str("usl".into())),
-            &axes
-        ));
-        assert!(!selects(&one("ppc", ParamValue::Int(2)), &axes));
+        let select = |params: Params| selects(&Selection::from(&params), &axes);
+        assert!(select(one("G", ParamValue::Int(1))));
+        assert!(select(Params::new()));
+        assert!(!select(one("method", text("usl"))));
+        assert!(!select(one("ppc", ParamValue::Int(2))));
+    }
+
+    #[test]
+    fn a_list_selects_runs_with_any_of_its_values() {
+        let run = |method: &str, g: f64| {
+            Params::from([
+                ("G".to_string(), ParamValue::Float(g)),
+                ("method".to_string(), text(method)),
+            ])
+        };
+        let tls = any_of("method", vec![text("mpm_musl"), text("mpm_tls")]);
+        assert!(selects(&tls, &run("mpm_musl", 0.1)));
+        assert!(selects(&tls, &run("mpm_tls", 0.1)));
+        assert!(!selects(&tls, &run("mpm", 0.1)));
+        // Numbers still compare by value, and every axis named must match.
+        let both = Selection::from_iter([
+            (
+                "G".to_string(),
+                vec![ParamValue::Int(1), ParamValue::Float(0.1)].into(),
+            ),
+            ("method".to_string(), vec![text("mpm_tls")].into()),
+        ]);
+        assert!(selects(&both, &run("mpm_tls", 1.0)));
+        assert!(!selects(&both, &run("mpm_musl", 1.0)));
+        assert!(!selects(&both, &one("G", ParamValue::Float(0.1))));
+        let none = any_of("method", Vec::new());
+        assert!(
+            !selects(&none, &run("mpm", 0.1)),
+            "an empty list selects nothing"
+        );
+    }
+
+    #[test]
+    fn selection_labels_join_listed_values() {
+        let single = Params::from([
+            ("G".to_string(), ParamValue::Float(0.1)),
+            ("method".to_string(), text("mpm")),
+        ]);
+        // One value per axis reads exactly as the axes themselves.
+        assert_eq!(label(&Selection::from(&single)), label(&single));
+        assert_eq!(label(&single), "G=0.1 method=mpm");
+        let tls = any_of("method", vec![text("mpm_musl"), text("mpm_tls")]);
+        assert_eq!(label(&tls), "method=mpm_musl|mpm_tls");
+        assert_eq!(slug(&label(&tls)), "method_mpm_musl+mpm_tls");
+        let points = any_of(
+            "points",
+            vec![
+                ParamValue::List(vec![-0.6, 0.4]),
+                ParamValue::List(vec![0.5]),
+            ],
+        );
+        assert_eq!(label(&points), "points=[-0.6, 0.4]|[0.5]");
+        assert_eq!(slug(&label(&points)), "points_-0.6_0.4+0.5");
+    }
+
+    #[test]
+    fn scoped_labels_add_listed_values_of_axes_within_the_group() {
+        let group = one("G", ParamValue::Float(0.1));
+        let tls = any_of("method", vec![text("mpm_musl"), text("mpm_tls")]);
+        assert_eq!(scoped_label(&group, &tls), "G=0.1 method=mpm_musl|mpm_tls");
+        assert_eq!(
+            scoped_label(&Params::new(), &tls),
+            "method=mpm_musl|mpm_tls"
+        );
+        // A one-value selection, or one of an axis the group fixes, changes nothing.
+        let mpm = any_of("method", vec![text("mpm")]);
+        assert_eq!(scoped_label(&group, &mpm), "G=0.1");
+        let gs = any_of("G", vec![ParamValue::Float(0.1), ParamValue::Float(1.0)]);
+        assert_eq!(scoped_label(&group, &gs), "G=0.1");
     }
 
     #[test]
@@ -237,5 +341,6 @@ mod tests {
         assert_eq!(slug("G=0.1 method=mpm"), "G_0.1_method_mpm");
         assert_eq!(slug("a/b,c-d_e"), "a_b_c-d_e");
         assert_eq!(slug("points=[-0.6, 0.4]"), "points_-0.6_0.4");
+        assert_eq!(slug("method=a|b|c G=1"), "method_a+b+c_G_1");
     }
 }

@@ -5,7 +5,7 @@
 //! errors are fitted against h as a power law per field and norm.
 
 mod check;
-mod figures;
+pub mod figures;
 mod fit;
 mod format;
 mod group;
@@ -14,6 +14,7 @@ mod plot;
 mod pointwise;
 mod probe_table;
 pub mod stability;
+mod style;
 mod tables;
 
 use std::fs;

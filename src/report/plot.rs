@@ -9,13 +9,16 @@ use std::sync::Once;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use plotters::element::{DashedPathElement, DottedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 
-use super::figures::{Figure, Marker, Scale, Series};
+use super::figures::{Figure, Marker, Scale};
 use super::fit::min_max;
 use super::format::general;
+use super::style::{self, Pattern, Style};
 
 /// Width and height of the axes part of the image; the legend adds rows below it, so many
 /// curves make a taller image rather than squeezed axes.
@@ -26,21 +29,19 @@ const Y_LABEL_AREA: u32 = 80;
 const LEGEND_ROW: u32 = 24;
 /// Labels longer than this (about 300 px at 16 px) would run into the next column.
 const LEGEND_COLUMN_CHARS: usize = 34;
+/// The legend's sample of a series, and where its label starts.
+const GLYPH_WIDTH: i32 = 30;
+const LABEL_OFFSET: i32 = 38;
 const FONT: &str = "sans-serif";
-/// Colour-blind-safe qualitative palette (Okabe-Ito, grey for its yellow, which is too pale
-/// on white), cycled when curves outnumber it.
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-    RGBColor(0, 0, 0),
-    RGBColor(120, 120, 120),
-];
 /// Half the side of a square marker and the radius of a circle, in pixels.
 const MARKER_SIZE: i32 = 4;
+/// Dashes and their gaps, and the spacing and radius of dots, in pixels.
+const DASH: i32 = 8;
+const GAP: i32 = 5;
+const DOT_SPACING: i32 = 5;
+const DOT_RADIUS: i32 = 1;
+/// A line without markers of its own that needs them to be told apart carries this many.
+const MARKS_PER_LINE: usize = 8;
 
 fn register_fonts() {
     static ONCE: Once = Once::new();
@@ -51,8 +52,8 @@ fn register_fonts() {
     });
 }
 
-/// Writes `figure` as a PNG: each series' markers and its line (dashed for fits), with the
-/// legend below the axes so it never hides data.
+/// Writes `figure` as a PNG: each series' markers and its line in the style `style` gives it,
+/// with the legend below the axes so it never hides data.
 pub fn render(path: &Path, figure: &Figure) -> io::Result<()> {
     register_fonts();
     draw(path, figure).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
@@ -68,13 +69,14 @@ fn draw(path: &Path, figure: &Figure) -> DrawResult {
     let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (axes, legend) = root.split_vertically(AXES_HEIGHT);
-    draw_axes(&axes, figure)?;
-    draw_legend(&legend, figure, columns)?;
+    let styles = style::assign(&figure.series);
+    draw_axes(&axes, figure, &styles)?;
+    draw_legend(&legend, figure, &styles, columns)?;
     root.present()?;
     Ok(())
 }
 
-fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
+fn draw_axes(area: &Area, figure: &Figure, styles: &[Style]) -> DrawResult {
     let data: Vec<(f64, f64)> = figure
         .series
         .iter()
@@ -105,7 +107,7 @@ fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
                     .with_light_points(y_minor),
             )?;
             let label = |v: &f64| tick_label(*v);
-            draw_series(chart, figure, &label, &label)
+            draw_series(chart, figure, styles, &label, &label)
         }
         Scale::Linear => {
             let x_range = padded_linear_range(xs);
@@ -114,7 +116,7 @@ fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
                 builder.build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)?;
             let x_label = |v: &f64| linear_tick_label(*v, x_range);
             let y_label = |v: &f64| linear_tick_label(*v, y_range);
-            draw_series(chart, figure, &x_label, &y_label)
+            draw_series(chart, figure, styles, &x_label, &y_label)
         }
         Scale::LogY => {
             let x_range = padded_linear_range(xs);
@@ -129,16 +131,16 @@ fn draw_axes(area: &Area, figure: &Figure) -> DrawResult {
             )?;
             let x_label = |v: &f64| linear_tick_label(*v, x_range);
             let y_label = |v: &f64| tick_label(*v);
-            draw_series(chart, figure, &x_label, &y_label)
+            draw_series(chart, figure, styles, &x_label, &y_label)
         }
     }
 }
 
-/// The mesh with its labels, then every series: markers, and the line through its own points
-/// (dashed for a fit: a solid line through the markers would hide it where data follow it).
+/// The mesh with its labels, then every series: its line, and its markers over it.
 fn draw_series<X, Y>(
     mut chart: ChartContext<'_, BitMapBackend<'_>, Cartesian2d<X, Y>>,
     figure: &Figure,
+    styles: &[Style],
     x_label: &dyn Fn(&f64) -> String,
     y_label: &dyn Fn(&f64) -> String,
 ) -> DrawResult
@@ -157,33 +159,139 @@ where
         .bold_line_style(BLACK.mix(0.25))
         .light_line_style(BLACK.mix(0.08))
         .draw()?;
-    for (i, series) in figure.series.iter().enumerate() {
-        let style = curve_style(i, series);
-        if series.dashed {
-            chart.draw_series(DashedLineSeries::new(series.line.clone(), 8, 5, style))?;
-        } else if !series.line.is_empty() {
-            chart.draw_series(LineSeries::new(series.line.clone(), style))?;
+    for (series, style) in figure.series.iter().zip(styles) {
+        let shape = shape_style(style);
+        if let (Some(pattern), false) = (style.line, series.line.is_empty()) {
+            chart.draw_series([path(series.line.clone(), pattern, shape)])?;
         }
-        let points = series.markers.iter().copied();
-        match series.marker {
-            Marker::Circle => {
-                chart.draw_series(points.map(|p| Circle::new(p, MARKER_SIZE, style)))?;
-            }
-            Marker::Square => {
-                chart.draw_series(points.map(|p| EmptyElement::at(p) + square((0, 0), style)))?;
-            }
-            Marker::Cross => {
-                chart.draw_series(points.map(|p| Cross::new(p, 2 * MARKER_SIZE, style)))?;
-            }
+        if let Some(marker) = style.marker {
+            let points = if series.markers.is_empty() {
+                marks_along(&series.line)
+            } else {
+                series.markers.clone()
+            };
+            chart.draw_series(points.into_iter().map(|p| marker_at(p, marker, shape)))?;
         }
     }
     Ok(())
 }
 
-/// A square marker centred on `c` in pixels.
-fn square(c: (i32, i32), style: ShapeStyle) -> Rectangle<(i32, i32)> {
-    let s = MARKER_SIZE;
-    Rectangle::new([(c.0 - s, c.1 - s), (c.0 + s, c.1 + s)], style)
+fn shape_style(style: &Style) -> ShapeStyle {
+    style.rgb().filled().stroke_width(2)
+}
+
+/// A line through points of any coordinate system (data on the axes, pixels in the legend),
+/// in one of the patterns.
+struct Polyline<C> {
+    points: Vec<C>,
+    pattern: Pattern,
+    style: ShapeStyle,
+}
+
+fn path<C>(points: Vec<C>, pattern: Pattern, style: ShapeStyle) -> Polyline<C> {
+    Polyline {
+        points,
+        pattern,
+        style,
+    }
+}
+
+impl<'a, C> PointCollection<'a, C> for &'a Polyline<C> {
+    type Point = &'a C;
+    type IntoIter = &'a [C];
+
+    fn point_iter(self) -> &'a [C] {
+        &self.points
+    }
+}
+
+impl<C, DB: DrawingBackend> Drawable<DB> for Polyline<C> {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        points: I,
+        backend: &mut DB,
+        size: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let pixels: Vec<BackendCoord> = points.collect();
+        let style = self.style;
+        match self.pattern {
+            Pattern::Solid => backend.draw_path(pixels, &style),
+            Pattern::Dashed => DashedPathElement::new(pixels.clone(), DASH, GAP, style).draw(
+                pixels.into_iter(),
+                backend,
+                size,
+            ),
+            Pattern::Dotted => DottedPathElement::new(pixels.clone(), 0, DOT_SPACING, move |c| {
+                Circle::new(c, DOT_RADIUS, style)
+            })
+            .draw(pixels.into_iter(), backend, size),
+        }
+    }
+}
+
+/// A marker centred on a point of any coordinate system, its shape drawn in pixels around it.
+struct MarkerAt<C> {
+    at: C,
+    marker: Marker,
+    style: ShapeStyle,
+}
+
+fn marker_at<C>(at: C, marker: Marker, style: ShapeStyle) -> MarkerAt<C> {
+    MarkerAt { at, marker, style }
+}
+
+impl<'a, C> PointCollection<'a, C> for &'a MarkerAt<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
+
+    fn point_iter(self) -> std::iter::Once<&'a C> {
+        std::iter::once(&self.at)
+    }
+}
+
+impl<C, DB: DrawingBackend> Drawable<DB> for MarkerAt<C> {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        mut points: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some((x, y)) = points.next() else {
+            return Ok(());
+        };
+        let s = MARKER_SIZE;
+        // The triangle and diamond a pixel larger, to look as big as the circle and square.
+        let t = s + 1;
+        let style = &self.style;
+        match self.marker {
+            Marker::Circle => backend.draw_circle((x, y), s.unsigned_abs(), style, true),
+            Marker::Square => backend.draw_rect((x - s, y - s), (x + s, y + s), style, true),
+            Marker::Triangle => {
+                backend.fill_polygon([(x, y - t), (x + t, y + t), (x - t, y + t)], style)
+            }
+            Marker::Diamond => {
+                backend.fill_polygon([(x, y - t), (x + t, y), (x, y + t), (x - t, y)], style)
+            }
+            Marker::Cross => {
+                let c = 2 * s;
+                backend.draw_line((x - c, y - c), (x + c, y + c), style)?;
+                backend.draw_line((x - c, y + c), (x + c, y - c), style)
+            }
+        }
+    }
+}
+
+/// At most `MARKS_PER_LINE` points of a line, evenly spaced along its points and including
+/// both ends, for a line whose look needs markers.
+fn marks_along(line: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let n = line.len();
+    let marks = n.min(MARKS_PER_LINE);
+    if marks < 2 {
+        return line.to_vec();
+    }
+    (0..marks)
+        .map(|k| line[k * (n - 1) / (marks - 1)])
+        .collect()
 }
 
 fn legend_columns(figure: &Figure) -> usize {
@@ -196,43 +304,31 @@ fn legend_columns(figure: &Figure) -> usize {
 }
 
 /// Legend entries in columns aligned with the plot's left edge, filled row by row.
-fn draw_legend(area: &Area, figure: &Figure, columns: usize) -> DrawResult {
+fn draw_legend(area: &Area, figure: &Figure, styles: &[Style], columns: usize) -> DrawResult {
     let left = (MARGIN + Y_LABEL_AREA) as i32;
     let column_width = (WIDTH - MARGIN - Y_LABEL_AREA - MARGIN) as i32 / columns as i32;
     let font = TextStyle::from((FONT, 16).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
-    for (i, series) in figure.series.iter().enumerate() {
-        let style = curve_style(i, series);
+    for (i, (series, style)) in figure.series.iter().zip(styles).enumerate() {
         let x = left + (i % columns) as i32 * column_width;
         let y = ((i / columns) as u32 * LEGEND_ROW + LEGEND_ROW / 2) as i32;
-        draw_glyph(area, series, (x, y), style)?;
-        area.draw(&Text::new(series.label.clone(), (x + 34, y), font.clone()))?;
+        draw_glyph(area, style, (x, y))?;
+        let at = (x + LABEL_OFFSET, y);
+        area.draw(&Text::new(series.label.clone(), at, font.clone()))?;
     }
     Ok(())
 }
 
-/// A short line where the series has one, broken by its marker where it has markers.
-fn draw_glyph(area: &Area, series: &Series, (x, y): (i32, i32), style: ShapeStyle) -> DrawResult {
-    let segment = |from: i32, to: i32| PathElement::new([(x + from, y), (x + to, y)], style);
-    if !series.line.is_empty() {
-        area.draw(&segment(0, 7))?;
-        area.draw(&segment(17, 24))?;
+/// The series' look as drawn on the axes: its line across the glyph in its pattern, its
+/// marker over the middle.
+fn draw_glyph(area: &Area, style: &Style, (x, y): (i32, i32)) -> DrawResult {
+    let shape = shape_style(style);
+    if let Some(pattern) = style.line {
+        area.draw(&path(vec![(x, y), (x + GLYPH_WIDTH, y)], pattern, shape))?;
     }
-    match (series.markers.is_empty(), series.marker) {
-        (true, _) => area.draw(&segment(7, 17))?,
-        (false, Marker::Circle) => area.draw(&Circle::new((x + 12, y), MARKER_SIZE, style))?,
-        (false, Marker::Square) => area.draw(&square((x + 12, y), style))?,
-        (false, Marker::Cross) => area.draw(&Cross::new((x + 12, y), 2 * MARKER_SIZE, style))?,
+    if let Some(marker) = style.marker {
+        area.draw(&marker_at((x + GLYPH_WIDTH / 2, y), marker, shape))?;
     }
     Ok(())
-}
-
-fn curve_style(index: usize, series: &Series) -> ShapeStyle {
-    let colour = if series.neutral {
-        PALETTE[PALETTE.len() - 1]
-    } else {
-        PALETTE[index % PALETTE.len()]
-    };
-    colour.filled().stroke_width(2)
 }
 
 /// The data range widened by a tenth of its log span on each side (at least a tenth of a

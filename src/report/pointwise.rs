@@ -5,7 +5,9 @@
 //! run files unchanged.
 
 use super::format::general;
-use super::group::{axis_values, group_runs, label, ordered_runs, selects, title_suffix};
+use super::group::{
+    axis_values, group_runs, label, ordered_runs, scoped_label, selects, title_suffix,
+};
 use super::probe_table;
 use super::stability;
 use crate::experiment::{Experiment, TableKind, TableSpec};
@@ -73,7 +75,7 @@ fn nodal_errors<'a>(
             Some(Table {
                 title: format!(
                     "u(x_i) - u^h(x_i) at the nodes{}",
-                    title_suffix(&group.label)
+                    title_suffix(&scoped_label(&group.axes, &spec.select))
                 ),
                 note: "Four decimals as in Gong's Tables 4.1-4.2; an error below 1e-12 (rounding) \
                        is printed as 0, a node without data in reach as NaN."

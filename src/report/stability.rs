@@ -11,7 +11,7 @@
 //! first unstable one and that first unstable value.
 
 use super::format::general;
-use super::group::{group_runs, label, label_or_all, title_suffix};
+use super::group::{group_runs, label, label_or_all, scoped_label, title_suffix};
 use super::pointwise::Table;
 use crate::experiment::{StabilityAxes, TableSpec};
 use crate::linear_stability::{
@@ -191,7 +191,7 @@ pub fn tables<'a>(runs: impl IntoIterator<Item = &'a RunSummary>, spec: &TableSp
             Some(Table {
                 title: format!(
                     "Stability limit along {sweep}{}",
-                    title_suffix(&group.label)
+                    title_suffix(&scoped_label(&group.axes, &spec.select))
                 ),
                 note: note(with_bounds),
                 header,

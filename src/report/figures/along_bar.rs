@@ -2,7 +2,7 @@
 //! current position x, the experiment's reference run as grey markers.
 
 use super::{Figure, Names, Scale, Series};
-use crate::experiment::{Experiment, FigureSpec};
+use crate::experiment::{Experiment, FigureSpec, Selection};
 use crate::output::{Profile, RunStatus, RunSummary};
 use crate::report::group::{label, ordered_runs, selects};
 
@@ -18,9 +18,9 @@ pub(super) fn figures(
     spec: &FigureSpec,
     names: &mut Names,
 ) -> Vec<Figure> {
+    let reference_axes = experiment.reference.as_ref().map(Selection::from);
     let is_reference = |run: &RunSummary| {
-        experiment
-            .reference
+        reference_axes
             .as_ref()
             .is_some_and(|select| selects(select, &run.axes))
     };

@@ -7,7 +7,7 @@ use crate::output::RunSummary;
 use crate::report::fit::{fit_loglog, min_max};
 use crate::report::format::rate;
 use crate::report::group::{
-    group_runs, label_or_all, title_suffix, usable_points, REFINEMENT_AXIS,
+    group_runs, label_or_all, scoped_label, title_suffix, usable_points, REFINEMENT_AXIS,
 };
 
 /// One figure per combination of the axes other than the refinement axis and `by`.
@@ -26,13 +26,14 @@ pub(super) fn figures(
             if series.is_empty() {
                 return None;
             }
-            let which = label_or_all(&group.label);
+            let scope = scoped_label(&group.axes, &spec.select);
+            let which = label_or_all(&scope);
             let title = format!(
                 "{}: {} ({} norm){}",
                 experiment.name,
                 spec.fields.join(", "),
                 spec.norm,
-                title_suffix(&group.label)
+                title_suffix(&scope)
             );
             Some(Figure {
                 file: names.file(experiment, &format!("{which}_{}", spec.norm)),

@@ -6,7 +6,9 @@ use super::{Figure, Marker, Names, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec};
 use crate::output::{ProbeRecord, RunStatus, RunSummary};
 use crate::report::format::general;
-use crate::report::group::{group_runs, label, label_or_all, recorded_probes, title_suffix};
+use crate::report::group::{
+    group_runs, label, label_or_all, recorded_probes, scoped_label, title_suffix,
+};
 
 /// Names of the components of vectors and tensors, by index.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -46,10 +48,11 @@ pub(super) fn figures(
         if let Some(reference) = reference(&probes) {
             series.push(reference);
         }
-        let which = format!("{name}_{}", label_or_all(&group.label));
+        let scope = scoped_label(&group.axes, &spec.select);
+        let which = format!("{name}_{}", label_or_all(&scope));
         figures.push(Figure {
             file: names.file(experiment, &which),
-            title: format!("{}: {name}{}", experiment.name, title_suffix(&group.label)),
+            title: format!("{}: {name}{}", experiment.name, title_suffix(&scope)),
             x_label: "t (s)".into(),
             y_label: quantity_label(first),
             scale: Scale::Linear,

@@ -12,9 +12,8 @@ use std::path::PathBuf;
 
 use super::group::{selects, slug};
 use crate::benchmarks::BenchmarkKind;
-use crate::experiment::{Experiment, FigureKind, FigureSpec};
+use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
 use crate::output::RunSummary;
-use crate::params::Params;
 
 /// How the axes of a figure are scaled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,21 +25,26 @@ pub enum Scale {
     LogY,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Marker {
     Circle,
     Square,
+    Triangle,
+    Diamond,
     /// Where a diverged run stopped.
     Cross,
 }
 
-/// One legend entry: markers at some points and a line through others, in one colour.
+/// One legend entry: markers at some points and a line through others, in one colour. The
+/// marker and line asked for here are what the series gets unless an earlier series of the
+/// figure already looks so (`report::style`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
     pub label: String,
     pub markers: Vec<(f64, f64)>,
     pub marker: Marker,
     pub line: Vec<(f64, f64)>,
+    /// A fit or a bound: the line is dashed (dotted to tell it from another), never solid.
     pub dashed: bool,
     /// Drawn in grey whatever its place: a reference the other series are judged against.
     pub neutral: bool,
@@ -96,7 +100,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
         fields: measures.fields.iter().map(|f| f.to_string()).collect(),
         norm: measures.norms[0].to_string(),
         by: Vec::new(),
-        select: Params::new(),
+        select: Selection::default(),
         stability: None,
         probe: None,
     }];

@@ -5,7 +5,7 @@ use super::{Figure, Names, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec};
 use crate::output::{RunSummary, ShapeFunctionRecord};
 use crate::report::format::general;
-use crate::report::group::{group_runs, label, label_or_all, title_suffix};
+use crate::report::group::{group_runs, label_or_all, scoped_label, title_suffix};
 
 /// The basis drawn in grey, as the reference LME tends to for large gamma.
 const REFERENCE_BASIS: &str = "linear";
@@ -40,6 +40,7 @@ pub(super) fn figures(
         if runs.is_empty() {
             continue;
         }
+        let scope = scoped_label(&group.axes, &spec.select);
         for (what, y_label, component) in [
             ("value", "N_a", None),
             ("gradient", "dN_a/dx (1/h)", Some(0)),
@@ -55,14 +56,11 @@ pub(super) fn figures(
             figures.push(Figure {
                 file: names.file(
                     experiment,
-                    &format!(
-                        "shape_functions_{what}_{}",
-                        label_or_all(&label(&group.axes))
-                    ),
+                    &format!("shape_functions_{what}_{}", label_or_all(&scope)),
                 ),
                 title: format!(
                     "{y_label} of the centre node along y = y_a{}",
-                    title_suffix(&group.label)
+                    title_suffix(&scope)
                 ),
                 x_label: "(x - x_a) / h".into(),
                 y_label: y_label.into(),

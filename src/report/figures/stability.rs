@@ -5,7 +5,7 @@ use super::{Figure, Marker, Names, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec, StabilityAxes};
 use crate::output::RunSummary;
 use crate::report::format::general;
-use crate::report::group::group_runs;
+use crate::report::group::{group_runs, label_or_all, scoped_label};
 use crate::report::stability::{
     group_name, limits, outcome, particles_per_cell, predicted, Verdict, PPC_AXIS, THRESHOLD,
 };
@@ -47,7 +47,7 @@ pub(super) fn limit_figures(
                 Series::markers(format!("last stable {sweep}"), Marker::Circle, stable),
                 Series::markers(format!("first unstable {sweep}"), Marker::Square, unstable),
             ]);
-            let name = group_name(&group.axes);
+            let name = label_or_all(&scoped_label(&group.axes, &spec.select));
             Some(Figure {
                 file: names.file(experiment, &format!("stability_{name}")),
                 title: format!(
