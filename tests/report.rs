@@ -364,6 +364,36 @@ fn figure_specs_split_by_the_remaining_axes() {
     assert!(!read(dir.path(), "report.md").contains("## Checks"));
 }
 
+/// One figure per field of a group: each file names its field.
+#[test]
+fn single_field_figures_are_named_by_their_field() {
+    let spec = |field: &str| FigureSpec {
+        kind: FigureKind::Convergence,
+        fields: vec![field.into()],
+        norm: "rms".into(),
+        by: vec!["method".into(), "G".into()],
+        select: Selection::default(),
+        stability: None,
+        probe: None,
+    };
+    let exp = experiment(vec![], vec![spec("velocity"), spec("stress")]);
+    let dir = tempfile::tempdir().unwrap();
+    let runs = runs();
+    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
+    let names: Vec<String> = report
+        .figures
+        .iter()
+        .map(|f| f.to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "figures/gong_conv_all_velocity_rms.png",
+            "figures/gong_conv_all_stress_rms.png",
+        ]
+    );
+}
+
 #[test]
 fn a_matrix_over_cells_alone_is_one_group() {
     let mut exp = experiment(vec![], vec![]);

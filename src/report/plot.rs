@@ -43,6 +43,13 @@ const DOT_RADIUS: i32 = 1;
 /// A line without markers of its own that needs them to be told apart carries this many.
 const MARKS_PER_LINE: usize = 8;
 
+/// The caption's font size: 22 px, smaller for a title that would not fit the width at 22 px
+/// (DejaVu Sans Bold averages about 0.62 em per character), but never below 12 px.
+fn caption_size(title: &str) -> f64 {
+    let fitting = f64::from(WIDTH - 2 * MARGIN) / (0.62 * title.chars().count() as f64);
+    fitting.clamp(12.0, 22.0)
+}
+
 fn register_fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
@@ -86,7 +93,12 @@ fn draw_axes(area: &Area, figure: &Figure, styles: &[Style]) -> DrawResult {
     let ys = data.iter().map(|p| p.1);
     let mut builder = ChartBuilder::on(area);
     builder
-        .caption(&figure.title, (FONT, 22).into_font().style(FontStyle::Bold))
+        .caption(
+            &figure.title,
+            (FONT, caption_size(&figure.title))
+                .into_font()
+                .style(FontStyle::Bold),
+        )
         .margin(MARGIN)
         .x_label_area_size(55)
         .y_label_area_size(Y_LABEL_AREA);

@@ -36,7 +36,7 @@ pub(super) fn figures(
                 title_suffix(&scope)
             );
             Some(Figure {
-                file: names.file(experiment, &format!("{which}_{}", spec.norm)),
+                file: names.file(experiment, &file_stem(&which, spec)),
                 title,
                 x_label: "h (cell size)".into(),
                 y_label: format!("{} error", spec.norm),
@@ -73,7 +73,7 @@ fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
             curves.push(Series {
                 label: format!("{field}{by}{slope}"),
                 markers: points,
-                marker: Marker::Circle,
+                marker: Marker::DATA[curves.len() % Marker::DATA.len()],
                 line,
                 dashed: true,
                 neutral: false,
@@ -81,4 +81,13 @@ fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
         }
     }
     curves
+}
+
+/// `<group>_<norm>`, with the field before the norm when the figure draws only one, so that
+/// one figure per field of a group gets a name that says which.
+fn file_stem(which: &str, spec: &FigureSpec) -> String {
+    match spec.fields.as_slice() {
+        [field] => format!("{which}_{field}_{}", spec.norm),
+        _ => format!("{which}_{}", spec.norm),
+    }
 }

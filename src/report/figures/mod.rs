@@ -35,6 +35,17 @@ pub enum Marker {
     Cross,
 }
 
+impl Marker {
+    /// The shapes for data series that may lie on top of each other, in turn: where two
+    /// series have the same values, both shapes stay visible.
+    pub const DATA: [Marker; 4] = [
+        Marker::Circle,
+        Marker::Square,
+        Marker::Triangle,
+        Marker::Diamond,
+    ];
+}
+
 /// One legend entry: markers at some points and a line through others, in one colour. The
 /// marker and line asked for here are what the series gets unless an earlier series of the
 /// figure already looks so (`report::style`).
