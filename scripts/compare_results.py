@@ -6,13 +6,11 @@ For every experiment directory of A (one with an experiment.yaml) B must have th
 experiment.yaml, the same run files and no temporary files left, and every pair of run files
 must hold the same groups, datasets and attributes: every dataset with the same dtype, shape
 and bytes, every attribute equal. Excluded, because it records time: the root attribute
-`wall_seconds` of each run file, and the `wall_seconds` column of summary.csv. The report
-files (rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
+`wall_seconds` of each run file (and timings.csv, which is not compared). The report files
+(summary.csv, rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
 Exits 1 listing the differences.
 """
 
-import csv
-import io
 import sys
 from pathlib import Path
 
@@ -20,7 +18,6 @@ import h5py
 import numpy as np
 
 TIME_ATTRS = {("/", "wall_seconds")}
-TIME_COLUMNS = {"wall_seconds"}
 
 
 def value_bytes(value):
@@ -51,12 +48,6 @@ def contents(path):
     return items
 
 
-def summary_without_time(path):
-    rows = list(csv.reader(io.StringIO(path.read_text())))
-    keep = [i for i, name in enumerate(rows[0]) if name not in TIME_COLUMNS]
-    return [[row[i] for i in keep] for row in rows]
-
-
 def compare_experiment(a, b, problems, counts):
     name = a.name
     if not (b / "experiment.yaml").is_file():
@@ -85,7 +76,7 @@ def compare_experiment(a, b, problems, counts):
         counts["runs"] += 1
         counts["datasets"] += sum(1 for k in ca if k[1] == "dataset")
         counts["attributes"] += sum(1 for k in ca if k[1] == "attr")
-    for report in ["rates.csv", "report.md"] + sorted(
+    for report in ["summary.csv", "rates.csv", "report.md"] + sorted(
         str(p.relative_to(a)) for p in a.glob("figures/*.png")
     ):
         if not (a / report).exists():
@@ -94,13 +85,6 @@ def compare_experiment(a, b, problems, counts):
             problems.append(f"{name}: {report} missing in B")
         elif (a / report).read_bytes() != (b / report).read_bytes():
             problems.append(f"{name}: {report} differs")
-        else:
-            counts["report files"] += 1
-    if (a / "summary.csv").exists():
-        if not (b / "summary.csv").exists():
-            problems.append(f"{name}: summary.csv missing in B")
-        elif summary_without_time(a / "summary.csv") != summary_without_time(b / "summary.csv"):
-            problems.append(f"{name}: summary.csv differs (outside wall_seconds)")
         else:
             counts["report files"] += 1
 
@@ -121,8 +105,7 @@ def main(argv):
     print(
         f"{len(experiments)} experiments, {counts['runs']} run files: {counts['datasets']} "
         f"datasets and {counts['attributes']} attributes compared bit for bit (excluded: the "
-        f"root attribute wall_seconds), {counts['report files']} report files byte for byte "
-        f"(summary.csv without its wall_seconds column): "
+        f"root attribute wall_seconds), {counts['report files']} report files byte for byte: "
         + ("identical" if not problems else f"{len(problems)} differences")
     )
     return 1 if problems else 0

@@ -54,8 +54,8 @@ pub struct Report {
     pub figures: Vec<PathBuf>,
 }
 
-/// Writes summary.csv, rates.csv, figures/*.png and report.md into `dir`; report.md gets a
-/// "Checks" section when `check` is given.
+/// Writes summary.csv, timings.csv, rates.csv, figures/*.png and report.md into `dir`;
+/// report.md gets a "Checks" section when `check` is given.
 pub fn write_report(
     dir: &Path,
     experiment: &Experiment,
@@ -72,6 +72,7 @@ pub fn write_report(
         dir.join("summary.csv"),
         tables::summary_csv(experiment, runs),
     )?;
+    fs::write(dir.join("timings.csv"), tables::timings_csv(runs))?;
     fs::write(dir.join("rates.csv"), tables::rates_csv(rates))?;
     for figure in &figures {
         plot::render(&dir.join(&figure.file), figure)?;

@@ -1,4 +1,5 @@
-//! summary.csv and rates.csv, written by hand: the quoting rules are all we need of CSV.
+//! summary.csv, timings.csv and rates.csv, written by hand: the quoting rules are all we need
+//! of CSV.
 
 use std::borrow::Cow;
 
@@ -6,7 +7,7 @@ use super::format::exact;
 use super::group::{self, ordered_runs};
 use super::RateRow;
 use crate::experiment::Experiment;
-use crate::output::{Measures, RunSummary};
+use crate::output::{Measures, RunStatus, RunSummary};
 
 const RATE_COLUMNS: [&str; 10] = [
     "experiment",
@@ -36,7 +37,6 @@ pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
         let taken = experiment.axes.iter().any(|a| a == "dt");
         header.extend(["steps", if taken { "dt_used" } else { "dt" }].map(String::from));
     }
-    header.push("wall_seconds".into());
     header.extend(norm_columns(measures).map(|(field, norm)| format!("{norm}_{field}")));
     header.push("message".into());
 
@@ -47,15 +47,32 @@ pub fn summary_csv(experiment: &Experiment, runs: &[RunSummary]) -> String {
         if stepped {
             row.extend([run.steps.to_string(), exact(run.dt)]);
         }
-        row.push(exact(run.wall_seconds));
+        // A run that stopped early has no final errors: its last sample may be t = 0.
+        let finished = run.status == RunStatus::Ok;
         row.extend(norm_columns(measures).map(|(field, norm)| {
             run.final_norms
                 .get(&(field.to_string(), norm.to_string()))
+                .filter(|_| finished)
                 .map(|&e| exact(e))
                 .unwrap_or_default()
         }));
         row.push(run.message.clone());
         row
+    });
+    csv(&header, rows)
+}
+
+/// How long each run took, in the order of summary.csv: kept apart from it because it
+/// changes with every rerun and machine, while summary.csv reproduces byte for byte.
+pub fn timings_csv(runs: &[RunSummary]) -> String {
+    let header = ["run_id", "status", "steps", "wall_seconds"].map(String::from);
+    let rows = ordered_runs(runs).into_iter().map(|run| {
+        vec![
+            run.run_id.clone(),
+            run.status.as_str().to_string(),
+            run.steps.to_string(),
+            exact(run.wall_seconds),
+        ]
     });
     csv(&header, rows)
 }
