@@ -2,8 +2,8 @@
 #
 #   make            (= make all) install what is missing, build, run every experiments/*.yaml
 #                   into results/<name>/ and write its report
-#   make test       lint, unit tests, reduced matrices in tests/matrices/, HDF5 layout test,
-#                   `mpmlab report --check` on each reduced matrix, then test-slurm
+#   make test       lint, unit tests, reduced matrices in tests/matrices/, `mpmlab report
+#                   --check` on each reduced matrix, HDF5 layout test, then test-slurm
 #   make test-slurm the reduced matrices as a Slurm array on a one-node cluster started for
 #                   the test (installs slurm and munge when missing), compared bit for bit
 #                   with a single-machine run
@@ -125,13 +125,14 @@ test: deps lint build
 	mkdir -p "$(TEST_OUT)"
 	step "$(BIN) run --out $(TEST_OUT) $(RUN_FLAGS) $${files[*]}"
 	$(BIN) run --out "$(TEST_OUT)" $(RUN_FLAGS) "$${files[@]}"
-	step "pytest tests/python (MPMLAB_RESULTS=$(TEST_OUT))"
-	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
 	for f in "$${files[@]}"; do
 	  name=$$(basename "$$f" .yaml)
 	  step "$(BIN) report $(TEST_OUT)/$$name --check"
 	  $(BIN) report "$(TEST_OUT)/$$name" --check
 	done
+	# After the reports, so that the layout test also checks the figures' data files.
+	step "pytest tests/python (MPMLAB_RESULTS=$(TEST_OUT))"
+	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
 	step "scripts/test-slurm.sh (make test-slurm)"
 	scripts/test-slurm.sh "$(BIN)" "$(VENV_PY)"
 

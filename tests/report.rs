@@ -275,7 +275,26 @@ fn report_files_are_written_and_deterministic() {
         assert!(png.len() > 1000);
         assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
         assert_eq!(png, fs::read(dirs[1].path().join(figure)).unwrap());
+        // The data beside it: every plotted point, markers first, then the fit's ends.
+        let data = read(dir, &figure.with_extension("csv").to_string_lossy());
+        let rows: Vec<&str> = data.lines().collect();
+        assert_eq!(rows[0], "series,role,h (cell size),l2 error");
+        let markers = rows.iter().filter(|r| r.contains(",marker,")).count();
+        let lines = rows.iter().filter(|r| r.contains(",line,")).count();
+        assert!(markers >= 2 && lines >= 2, "{data}");
     }
+    let csv = read(dir, "figures/gong_conv_G_0.05_method_mpm_l2.csv");
+    let coarse = runs
+        .iter()
+        .find(|r| r.run_id == "mpm-G0.05-c8")
+        .expect("the fixture has mpm at G = 0.05 on 8 cells");
+    let velocity = coarse.final_norms[&("velocity".to_string(), "l2".to_string())];
+    let point = format!(",marker,0.125,{velocity:?}");
+    assert!(
+        csv.lines()
+            .any(|r| r.starts_with("velocity") && r.ends_with(&point)),
+        "{csv}"
+    );
     for name in ["summary.csv", "rates.csv", "report.md"] {
         assert_eq!(read(dir, name), read(dirs[1].path(), name), "{name}");
     }

@@ -54,7 +54,8 @@ pub struct Report {
     pub figures: Vec<PathBuf>,
 }
 
-/// Writes summary.csv, timings.csv, rates.csv, figures/*.png and report.md into `dir`;
+/// Writes summary.csv, timings.csv, rates.csv, figures/*.png with their data figures/*.csv,
+/// and report.md into `dir`;
 /// report.md gets a "Checks" section when `check` is given.
 pub fn write_report(
     dir: &Path,
@@ -75,7 +76,9 @@ pub fn write_report(
     fs::write(dir.join("timings.csv"), tables::timings_csv(runs))?;
     fs::write(dir.join("rates.csv"), tables::rates_csv(rates))?;
     for figure in &figures {
-        plot::render(&dir.join(&figure.file), figure)?;
+        let png = dir.join(&figure.file);
+        plot::render(&png, figure)?;
+        fs::write(png.with_extension("csv"), tables::figure_csv(figure))?;
     }
     let md = markdown::report_md(experiment, runs, rates, &tables, &figures, check);
     fs::write(dir.join("report.md"), md)?;
@@ -84,14 +87,16 @@ pub fn write_report(
     })
 }
 
-/// PNGs left by an earlier report whose figure this report no longer draws would otherwise
-/// be committed beside the current ones.
+/// PNGs and their data left by an earlier report whose figure this report no longer draws
+/// would otherwise be committed beside the current ones.
 fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::Result<()> {
     for entry in fs::read_dir(figure_dir)? {
         let path = entry?.path();
-        let is_png = path.extension().is_some_and(|e| e == "png");
-        let current = figures.iter().any(|f| path.ends_with(&f.file));
-        if is_png && !current {
+        let ours = path.extension().is_some_and(|e| e == "png" || e == "csv");
+        let current = figures
+            .iter()
+            .any(|f| path.with_extension("png").ends_with(&f.file));
+        if ours && !current {
             fs::remove_file(&path)?;
         }
     }

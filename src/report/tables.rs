@@ -1,8 +1,9 @@
-//! summary.csv, timings.csv and rates.csv, written by hand: the quoting rules are all we need
-//! of CSV.
+//! summary.csv, timings.csv, rates.csv and each figure's data, written by hand: the quoting
+//! rules are all we need of CSV.
 
 use std::borrow::Cow;
 
+use super::figures::Figure;
 use super::format::exact;
 use super::group::{self, ordered_runs};
 use super::RateRow;
@@ -73,6 +74,30 @@ pub fn timings_csv(runs: &[RunSummary]) -> String {
             run.steps.to_string(),
             exact(run.wall_seconds),
         ]
+    });
+    csv(&header, rows)
+}
+
+/// A figure's series exactly as plotted, one row per point: `series` (the legend label),
+/// `role` (`marker` for a measured point, `line` for a point of the drawn line, a fit or a
+/// curve), x and y, written beside the PNG so that the figure can be redrawn elsewhere.
+pub fn figure_csv(figure: &Figure) -> String {
+    let header = [
+        "series".to_string(),
+        "role".to_string(),
+        figure.x_label.clone(),
+        figure.y_label.clone(),
+    ];
+    let rows = figure.series.iter().flat_map(|s| {
+        let points = |role: &'static str, points: &[(f64, f64)]| {
+            points
+                .iter()
+                .map(|&(x, y)| vec![s.label.clone(), role.to_string(), exact(x), exact(y)])
+                .collect::<Vec<_>>()
+        };
+        let mut rows = points("marker", &s.markers);
+        rows.extend(points("line", &s.line));
+        rows
     });
     csv(&header, rows)
 }

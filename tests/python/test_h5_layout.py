@@ -1464,3 +1464,53 @@ def test_probe_references_by_a_second_implementation(run):
             f"{base}/reference differs from the independent solution at steps "
             f"{np.flatnonzero(~close)[:10]}"
         )
+
+
+# A convergence figure's series label: "<field>, <axis>=<value>, ... (rate r)".
+CONVERGENCE_LABEL = re.compile(
+    r"^(?P<field>[a-z]+)(?P<axes>(, [a-z_]+=[^,()]+)*)( \(rate [-0-9.na]+\))?$"
+)
+
+
+def test_convergence_figure_data_matches_the_run_files():
+    """Every measured point of the reduced bar's convergence figure, as written beside the PNG,
+    is a finished run's final error in that field and norm at its h: the figure's data is the
+    run files' numbers, read back with h5py alone."""
+    root = _results_root()
+    if root is None or not (root / "ci_bar" / "figures").is_dir():
+        pytest.skip("no reduced bar report (make test writes it before this test)")
+    runs = []
+    for path in sorted((root / "ci_bar" / "runs").glob("*.h5")):
+        with h5py.File(path, "r") as f:
+            axes = {
+                k: (v.decode() if isinstance(v, bytes) else str(v))
+                for k, v in f["matrix"].attrs.items()
+            }
+            norms = {k: float(v) for k, v in f["errors/norms"].attrs.items()}
+            runs.append((float(f.attrs["h"]), str(f.attrs["status"]), axes, norms))
+    figures = sorted((root / "ci_bar" / "figures").glob("*.csv"))
+    assert figures, "the reduced bar's report wrote no figure data"
+    checked = 0
+    for data in figures:
+        lines = data.read_text().splitlines()
+        header = lines[0].split(",")
+        assert header[:2] == ["series", "role"], f"{data.name}: header {header}"
+        norm = header[3].split()[0]
+        for row in lines[1:]:
+            label, role, x, y = row.rsplit(",", 3)
+            label = label.strip('"')
+            if role != "marker":
+                continue
+            m = CONVERGENCE_LABEL.match(label)
+            assert m, f"{data.name}: unexpected series label {label!r}"
+            field = m["field"]
+            wanted = dict(a.split("=", 1) for a in m["axes"].split(", ")[1:])
+            matches = [
+                norms for h, status, axes, norms in runs
+                if status == "ok" and abs(h - float(x)) <= 1e-12 * h
+                and all(axes.get(k) == v for k, v in wanted.items())
+            ]
+            assert len(matches) == 1, f"{data.name}: {len(matches)} runs for {label!r} at h = {x}"
+            assert matches[0][f"{norm}_{field}"] == float(y), f"{data.name}: {label!r} at h = {x}"
+            checked += 1
+    assert checked >= 30, f"only {checked} points checked"

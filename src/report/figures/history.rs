@@ -13,6 +13,9 @@ use crate::report::group::{
 /// Names of the components of vectors and tensors, by index.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
 
+/// Time buckets a history line keeps its envelope of: about one per pixel column of the axes.
+const BUCKETS: usize = 600;
+
 /// One figure per group of the axes other than `by`, a line per run of the group. An error
 /// names the probe when no selected run records it, with the probes they do record.
 pub(super) fn figures(
@@ -71,6 +74,7 @@ fn line(run: &RunSummary, probe: &ProbeRecord, by: &[&str]) -> Series {
         .copied()
         .zip(probe.value.iter().copied())
         .collect();
+    let points = envelope(points, BUCKETS);
     let axes = if by.is_empty() {
         run.axes.clone()
     } else {
@@ -103,10 +107,37 @@ fn reference(probes: &[(&RunSummary, &ProbeRecord)]) -> Option<Series> {
         .zip(probe.reference.iter().copied());
     let mut series = Series::line(
         probe.reference_kind.clone(),
-        points.filter(|(_, r)| r.is_finite()).collect(),
+        envelope(points.filter(|(_, r)| r.is_finite()).collect(), BUCKETS),
     );
     series.neutral = true;
     Some(series)
+}
+
+/// A line of many points as the axes can show it: split into `buckets` runs of consecutive
+/// points, each keeps its first, lowest, highest and last point in time order, so the drawn
+/// line covers the same range in every pixel column (and the figure's data file stays small).
+/// A line of at most 4 points per bucket is kept whole; the last point is always kept.
+fn envelope(points: Vec<(f64, f64)>, buckets: usize) -> Vec<(f64, f64)> {
+    if points.len() <= 4 * buckets {
+        return points;
+    }
+    let size = points.len().div_ceil(buckets);
+    let mut kept = Vec::with_capacity(4 * buckets);
+    for chunk in points.chunks(size) {
+        let by_y = |a: &&(f64, f64), b: &&(f64, f64)| a.1.total_cmp(&b.1);
+        let (low, high) = (
+            chunk.iter().min_by(by_y).expect("chunks are not empty"),
+            chunk.iter().max_by(by_y).expect("chunks are not empty"),
+        );
+        let mut four = [chunk[0], *low, *high, chunk[chunk.len() - 1]];
+        four.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for p in four {
+            if kept.last() != Some(&p) {
+                kept.push(p);
+            }
+        }
+    }
+    kept
 }
 
 /// E.g. `velocity x (m/s)`, `stress yy (Pa)`.
@@ -117,4 +148,29 @@ fn quantity_label(probe: &ProbeRecord) -> String {
         .map(|&k| AXIS_NAMES.get(k as usize).copied().unwrap_or("?"))
         .collect();
     format!("{} {component} ({})", probe.quantity, probe.unit())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::envelope;
+
+    /// A short line is kept whole; a long one keeps each bucket's extremes and both ends.
+    #[test]
+    fn the_envelope_keeps_ends_and_extremes() {
+        let short: Vec<(f64, f64)> = (0..8).map(|i| (i as f64, (i % 3) as f64)).collect();
+        assert_eq!(envelope(short.clone(), 2), short);
+        let long: Vec<(f64, f64)> = (0..1000)
+            .map(|i| (i as f64, ((i as f64) * 0.37).sin()))
+            .collect();
+        let kept = envelope(long.clone(), 10);
+        assert!(kept.len() <= 40, "{} points", kept.len());
+        assert_eq!(kept.first(), long.first());
+        assert_eq!(kept.last(), long.last());
+        assert!(kept.windows(2).all(|w| w[0].0 < w[1].0));
+        for chunk in long.chunks(100) {
+            let high = chunk.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+            let low = chunk.iter().map(|p| p.1).fold(f64::MAX, f64::min);
+            assert!(kept.iter().any(|p| p.1 == high) && kept.iter().any(|p| p.1 == low));
+        }
+    }
 }
