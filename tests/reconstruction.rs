@@ -207,6 +207,17 @@ fn wobbes_figures_conserve_with_a_fixed_mean_and_fig_2_matches_the_paper() {
         );
         assert_eq!(&fig1.data_element[..6], &[0, 0, 0, 1, 1, 1]);
     }
+    // The fixed mean's integral errors are round-off: no rate is fitted to them; the fitted
+    // variant's are real errors and keep theirs.
+    let rates = report::fit_rates(&collected.experiment, &collected.runs);
+    let integral = |method: &str| {
+        rates
+            .iter()
+            .filter(|r| r.norm == "integral" && r.group.contains(&format!("method={method}")))
+            .count()
+    };
+    assert_eq!(integral("tls_fixed"), 0);
+    assert!(integral("tls_fitted") > 0);
     checked_report(
         &collected,
         tmp.path(),

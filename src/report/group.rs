@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::fmt::Display;
 
 use crate::experiment::{Experiment, Selection};
-use crate::output::{RunStatus, RunSummary};
+use crate::output::{RunStatus, RunSummary, REFERENCE_NORM};
 use crate::params::{ParamValue, Params};
 
 /// The matrix axis that refines the grid: runs differing only in it form one convergence
@@ -176,6 +176,19 @@ pub fn usable_points(runs: &[&RunSummary], field: &str, norm: &str) -> Vec<(f64,
         .filter(|run| run.status == RunStatus::Ok)
         .filter_map(|run| Some((run.h, *run.final_norms.get(&key)?)))
         .filter(|&(h, error)| positive(h) && positive(error))
+        .collect()
+}
+
+/// Relative errors at or below this are round-off: about 4500 times the machine epsilon.
+pub const RELATIVE_ROUND_OFF: f64 = 1e-12;
+
+/// The points a convergence rate is fitted to: `usable_points` without the errors of a
+/// relative norm (`integral`, `reference`) that are round-off, whose slope would be noise.
+pub fn fit_points(runs: &[&RunSummary], field: &str, norm: &str) -> Vec<(f64, f64)> {
+    let relative = matches!(norm, "integral" | REFERENCE_NORM);
+    usable_points(runs, field, norm)
+        .into_iter()
+        .filter(|&(_, error)| !(relative && error <= RELATIVE_ROUND_OFF))
         .collect()
 }
 

@@ -6,7 +6,7 @@ use std::fmt::Write;
 use super::check::{describe, CheckFailure};
 use super::figures::Figure;
 use super::format::{general, rate};
-use super::group::{self, label, ordered_runs};
+use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
 use super::pointwise::Table;
 use super::RateRow;
 use crate::benchmarks::BenchmarkKind;
@@ -178,8 +178,11 @@ fn rates_table(md: &mut String, rates: &[RateRow]) {
         );
         return;
     }
-    md.push_str(
-        "Least-squares slope of log10(final error) against log10(h), over the runs that finished.\n\n",
+    let _ = writeln!(
+        md,
+        "Least-squares slope of log10(final error) against log10(h), over the runs that finished; \
+         relative errors (norms `integral` and `reference`) at or below {RELATIVE_ROUND_OFF:e} \
+         are round-off and left out of the fit.\n"
     );
     let header = ["group", "field", "norm", "rate", "r2", "points", "h range"].map(String::from);
     let rows = rates.iter().map(|r| {

@@ -104,14 +104,15 @@ fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::R
 }
 
 /// Fits every (group, field, norm) with at least two finished runs of positive, finite
-/// error, sorted by group, then field and norm in the order of the experiment's measures.
+/// error that is not round-off (`group::fit_points`), sorted by group, then field and norm in
+/// the order of the experiment's measures.
 pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
     let measures = experiment.measures();
     let mut rows = Vec::new();
     for g in group::group_runs(runs, &[group::REFINEMENT_AXIS]) {
         for &field in measures.fields {
             for &norm in measures.norms {
-                let points = group::usable_points(&g.runs, field, norm);
+                let points = group::fit_points(&g.runs, field, norm);
                 let Some(line) = fit::fit_loglog(&points) else {
                     continue;
                 };

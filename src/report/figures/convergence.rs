@@ -7,7 +7,8 @@ use crate::output::RunSummary;
 use crate::report::fit::{fit_loglog, min_max};
 use crate::report::format::rate;
 use crate::report::group::{
-    group_runs, label_or_all, scoped_label, title_suffix, usable_points, REFINEMENT_AXIS,
+    fit_points, group_runs, label_or_all, scoped_label, title_suffix, usable_points,
+    REFINEMENT_AXIS,
 };
 
 /// One figure per combination of the axes other than the refinement axis and `by`.
@@ -64,10 +65,12 @@ fn curves(runs: &[&RunSummary], spec: &FigureSpec) -> Vec<Series> {
             if points.is_empty() {
                 continue;
             }
-            let fit = fit_loglog(&points);
+            // Round-off errors are drawn but not fitted (`fit_points`).
+            let fitted = fit_points(&sub.runs, field, &spec.norm);
+            let fit = fit_loglog(&fitted);
             let slope = fit.map_or(String::new(), |f| format!(" (rate {})", rate(f.slope)));
             let line = fit.map_or_else(Vec::new, |f| {
-                let (h_lo, h_hi) = min_max(points.iter().map(|p| p.0));
+                let (h_lo, h_hi) = min_max(fitted.iter().map(|p| p.0));
                 vec![(h_lo, f.eval(h_lo)), (h_hi, f.eval(h_hi))]
             });
             curves.push(Series {
