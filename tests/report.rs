@@ -371,14 +371,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         probe: None,
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
-    let dir = tempfile::tempdir().unwrap();
-    let runs = runs();
-    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
-    let names: Vec<String> = report
-        .figures
-        .iter()
-        .map(|f| f.to_string_lossy().into_owned())
-        .collect();
+    let (dir, names) = figure_names(&exp);
     assert_eq!(
         names,
         [
@@ -389,6 +382,20 @@ fn figure_specs_split_by_the_remaining_axes() {
         ]
     );
     assert!(!read(dir.path(), "report.md").contains("## Checks"));
+}
+
+/// The report of `exp` over the fixture's runs in a temporary directory, and its figures'
+/// files.
+fn figure_names(exp: &Experiment) -> (tempfile::TempDir, Vec<String>) {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = runs();
+    let report = write_report(dir.path(), exp, &runs, &fit_rates(exp, &runs), None).unwrap();
+    let names = report
+        .figures
+        .iter()
+        .map(|f| f.to_string_lossy().into_owned())
+        .collect();
+    (dir, names)
 }
 
 /// One figure per field of a group: each file names its field.
@@ -404,14 +411,7 @@ fn single_field_figures_are_named_by_their_field() {
         probe: None,
     };
     let exp = experiment(vec![], vec![spec("velocity"), spec("stress")]);
-    let dir = tempfile::tempdir().unwrap();
-    let runs = runs();
-    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
-    let names: Vec<String> = report
-        .figures
-        .iter()
-        .map(|f| f.to_string_lossy().into_owned())
-        .collect();
+    let (_dir, names) = figure_names(&exp);
     assert_eq!(
         names,
         [
