@@ -16,15 +16,12 @@ use crate::shape::Stencils;
 
 pub struct ConsistentMassTransfer<const D: usize> {
     solver: MassSolver<D>,
-    /// Sum of p_i of the last mapping or remap: the momentum the DOFs received.
-    momentum_total: SVector<f64, D>,
 }
 
 impl<const D: usize> ConsistentMassTransfer<D> {
     pub fn new(num_dofs: usize, fixed: &[FixedDof]) -> Self {
         ConsistentMassTransfer {
             solver: MassSolver::new(MassMatrix::Consistent, num_dofs, fixed),
-            momentum_total: SVector::zeros(),
         }
     }
 
@@ -48,9 +45,8 @@ impl<const D: usize> ConsistentMassTransfer<D> {
             }
         }
         self.solver.factor(&grid.mass, grid.empty_mass)?;
-        self.momentum_total = grid.velocity.iter().sum();
         self.solver
-            .solve(&grid.mass, grid.empty_mass, &mut grid.velocity);
+            .solve_momenta(&grid.mass, grid.empty_mass, &mut grid.velocity);
         Ok(())
     }
 
@@ -64,8 +60,7 @@ impl<const D: usize> ConsistentMassTransfer<D> {
         out: &mut [SVector<f64, D>],
     ) {
         momentum_sums(stencils, particles, out);
-        self.momentum_total = out.iter().sum();
-        self.solver.solve(&grid.mass, grid.empty_mass, out);
+        self.solver.solve_momenta(&grid.mass, grid.empty_mass, out);
     }
 
     /// a = M^-1 f, v_new = v + kick a; fixed components and empty DOFs held at zero.
@@ -76,7 +71,7 @@ impl<const D: usize> ConsistentMassTransfer<D> {
 
     /// Total of p_i at the last mapping or remap, before the solve.
     pub fn momentum_total(&self) -> SVector<f64, D> {
-        self.momentum_total
+        self.solver.received_momentum()
     }
 }
 

@@ -32,6 +32,8 @@ pub struct MassSolver<const D: usize> {
     factors: Vec<BandMatrix>,
     free: Vec<Vec<u32>>,
     rhs: Vec<f64>,
+    /// sum_i p_i of the last `solve_momenta`: the momentum the DOFs received.
+    received: SVector<f64, D>,
 }
 
 impl<const D: usize> MassSolver<D> {
@@ -48,6 +50,7 @@ impl<const D: usize> MassSolver<D> {
             factors: vec![BandMatrix::default(); D],
             free: vec![Vec::new(); D],
             rhs: Vec::new(),
+            received: SVector::zeros(),
         }
     }
 
@@ -100,6 +103,23 @@ impl<const D: usize> MassSolver<D> {
             })?;
         }
         Ok(())
+    }
+
+    /// Solves M v = p in place for nodal momenta p, keeping sum_i p_i, the momentum the DOFs
+    /// received before the solve and the boundary conditions (`received_momentum`).
+    pub fn solve_momenta(
+        &mut self,
+        mass: &[f64],
+        empty_mass: f64,
+        momenta: &mut [SVector<f64, D>],
+    ) {
+        self.received = momenta.iter().sum();
+        self.solve(mass, empty_mass, momenta);
+    }
+
+    /// sum_i p_i of the last `solve_momenta`.
+    pub fn received_momentum(&self) -> SVector<f64, D> {
+        self.received
     }
 
     /// Solves M x = b in place for a nodal field; the consistent matrix must be factorised.

@@ -56,8 +56,6 @@ pub struct TaylorTransfer<const D: usize> {
     fitted: TaylorFit<D>,
     /// The mass matrix of eq 10 (or its row sums) and its solve (eq 11).
     mass_solver: MassSolver<D>,
-    /// Sum of p_i of the last mapping: the momentum the DOFs received.
-    momentum_total: SVector<f64, D>,
 }
 
 impl<const D: usize> TaylorTransfer<D> {
@@ -113,7 +111,6 @@ impl<const D: usize> TaylorTransfer<D> {
             prescribed: (0..elements).map(|_| TaylorFit::default()).collect(),
             fitted: TaylorFit::default(),
             mass_solver: MassSolver::new(recipe.mass, num_dofs, fixed),
-            momentum_total: SVector::zeros(),
         }
     }
 
@@ -197,9 +194,8 @@ impl<const D: usize> TaylorTransfer<D> {
         if consistent {
             self.mass_solver.factor(&grid.mass, grid.empty_mass)?;
         }
-        self.momentum_total = grid.velocity.iter().sum();
         self.mass_solver
-            .solve(&grid.mass, grid.empty_mass, &mut grid.velocity);
+            .solve_momenta(&grid.mass, grid.empty_mass, &mut grid.velocity);
         Ok(stats)
     }
 
@@ -229,8 +225,8 @@ impl<const D: usize> TaylorTransfer<D> {
                 }
             }
         }
-        self.momentum_total = out.iter().sum();
-        self.mass_solver.solve(&grid.mass, grid.empty_mass, out);
+        self.mass_solver
+            .solve_momenta(&grid.mass, grid.empty_mass, out);
     }
 
     /// The grid solve with this transfer's mass matrix (`MassSolver::solve_grid`).
@@ -241,7 +237,7 @@ impl<const D: usize> TaylorTransfer<D> {
     /// Total of p_i (eq 9) at the last mapping or remap: the momentum the DOFs received,
     /// before the solve and the boundary conditions.
     pub fn momentum_total(&self) -> SVector<f64, D> {
-        self.momentum_total
+        self.mass_solver.received_momentum()
     }
 
     fn elements(&self) -> usize {

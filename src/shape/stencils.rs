@@ -44,11 +44,6 @@ impl<const D: usize> Stencils<D> {
         Ok(())
     }
 
-    /// The number of points whose stencils are stored.
-    pub fn points(&self) -> usize {
-        self.weight.len() / self.per_point.max(1)
-    }
-
     /// The largest distance between two node numbers in one point's stencil: the
     /// sub-diagonals of a matrix assembled from products N_i N_j at these points.
     pub fn bandwidth(&self) -> usize {
