@@ -411,6 +411,38 @@ fn figure_by_must_be_a_matrix_axis() {
     );
 }
 
+/// `name`, `title` and `paper` are checked where written; two figures cannot share a name.
+#[test]
+fn figure_names_and_titles_are_checked() {
+    let named = edited(
+        ", by: G}",
+        ", by: G, name: fig4_7, paper: \"Gong 2015, Fig 4.7\"}",
+    );
+    let exp = parse(&named).unwrap();
+    assert_eq!(exp.figures[0].name.as_deref(), Some("fig4_7"));
+    assert_eq!(exp.figures[0].paper.as_deref(), Some("Gong 2015, Fig 4.7"));
+    assert_eq!(exp.figures[0].title, None);
+    let e = error(&edited(", by: G}", ", by: G, name: fig 4.7}"));
+    check(&e, 12, 89, "figures[0].name", "a file stem", &[]);
+    let e = error(&edited(", by: G}", ", by: G, name: a/b}"));
+    check(&e, 12, 89, "figures[0].name", "letters, digits", &[]);
+    let e = error(&edited(", by: G}", ", by: G, title: \"  \"}"));
+    check(&e, 12, 90, "figures[0].title", "non-empty text", &[]);
+    let twice = edited(
+        ", by: G}",
+        ", by: G, name: f}\n  - {kind: convergence, fields: [stress], name: f}",
+    );
+    let e = error(&twice);
+    check(
+        &e,
+        13,
+        49,
+        "figures[1].name",
+        "another figure is named 'f'",
+        &[],
+    );
+}
+
 #[test]
 fn output_interval_must_be_positive() {
     for bad in ["0", "-5"] {

@@ -275,13 +275,18 @@ fn report_files_are_written_and_deterministic() {
         assert!(png.len() > 1000);
         assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
         assert_eq!(png, fs::read(dirs[1].path().join(figure)).unwrap());
-        // The data beside it: every plotted point, markers first, then the fit's ends.
+        // The data beside it: every plotted point, markers first, then the line through
+        // them and the fit's ends.
         let data = read(dir, &figure.with_extension("csv").to_string_lossy());
         let rows: Vec<&str> = data.lines().collect();
-        assert_eq!(rows[0], "series,role,h (cell size),l2 error");
-        let markers = rows.iter().filter(|r| r.contains(",marker,")).count();
-        let lines = rows.iter().filter(|r| r.contains(",line,")).count();
-        assert!(markers >= 2 && lines >= 2, "{data}");
+        assert_eq!(
+            rows[0],
+            "series,role,\"h, cell size (m)\",l2 error (units in the legend)"
+        );
+        let count = |role: &str| rows.iter().filter(|r| r.contains(role)).count();
+        let markers = count(",marker,");
+        assert!(markers >= 2 && count(",line,") == markers, "{data}");
+        assert!(count(",fit,") >= 2, "{data}");
     }
     let csv = read(dir, "figures/gong_conv_G_0.05_method_mpm_l2.csv");
     let coarse = runs
@@ -292,7 +297,7 @@ fn report_files_are_written_and_deterministic() {
     let point = format!(",marker,0.125,{velocity:?}");
     assert!(
         csv.lines()
-            .any(|r| r.starts_with("velocity") && r.ends_with(&point)),
+            .any(|r| r.starts_with("velocity (m/s·m)") && r.ends_with(&point)),
         "{csv}"
     );
     for name in ["summary.csv", "rates.csv", "report.md"] {
@@ -369,6 +374,9 @@ fn figure_specs_split_by_the_remaining_axes() {
         select: Selection::default(),
         stability: None,
         probe: None,
+        name: None,
+        title: None,
+        paper: None,
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let (dir, names) = figure_names(&exp);
@@ -382,6 +390,46 @@ fn figure_specs_split_by_the_remaining_axes() {
         ]
     );
     assert!(!read(dir.path(), "report.md").contains("## Checks"));
+}
+
+/// A named figure item: its files are its name with what tells its figures apart, and its
+/// captions its title after the paper's figure.
+#[test]
+fn named_figures_take_their_name_title_and_paper() {
+    let figure = FigureSpec {
+        kind: FigureKind::Convergence,
+        fields: vec!["velocity".into()],
+        norm: "rms".into(),
+        by: vec!["G".into()],
+        select: Selection::default(),
+        stability: None,
+        probe: None,
+        name: Some("fig4_7".into()),
+        title: Some("MPM convergence".into()),
+        paper: Some("Gong 2015, Fig 4.7".into()),
+    };
+    let exp = experiment(vec![], vec![figure]);
+    let (dir, names) = figure_names(&exp);
+    assert_eq!(
+        names,
+        [
+            "figures/fig4_7_method_mpm.png",
+            "figures/fig4_7_method_usl.png"
+        ]
+    );
+    let md = read(dir.path(), "report.md");
+    let caption =
+        "![Gong 2015, Fig 4.7: MPM convergence (method=mpm)](figures/fig4_7_method_mpm.png)";
+    assert!(md.contains(caption), "{md}");
+    let csv = read(dir.path(), "figures/fig4_7_method_mpm.csv");
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .contains("velocity error, rms norm (m/s)"),
+        "{csv}"
+    );
+    assert!(csv.lines().any(|l| l.contains(",fit,")), "{csv}");
 }
 
 /// The report of `exp` over the fixture's runs in a temporary directory, and its figures'
@@ -409,6 +457,9 @@ fn single_field_figures_are_named_by_their_field() {
         select: Selection::default(),
         stability: None,
         probe: None,
+        name: None,
+        title: None,
+        paper: None,
     };
     let exp = experiment(vec![], vec![spec("velocity"), spec("stress")]);
     let (_dir, names) = figure_names(&exp);
@@ -492,6 +543,9 @@ fn history(probe: &str) -> FigureSpec {
         select: Selection::default(),
         stability: None,
         probe: Some(probe.into()),
+        name: None,
+        title: None,
+        paper: None,
     }
 }
 

@@ -1,5 +1,7 @@
 //! `figures` entries: which plots the report draws.
 
+use std::cell::RefCell;
+
 use crate::benchmarks::BenchmarkKind;
 use crate::output::Measures;
 
@@ -28,6 +30,7 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("history", FigureKind::History),
     ],
     keys: &["kind", "fields", "norm", "by", "x", "sweep", "probe"],
+    common: &["name", "title", "paper"],
     takes,
     suits: draws_for,
 };
@@ -38,15 +41,43 @@ pub(crate) fn read(
     benchmark: BenchmarkKind,
     measures: Measures,
 ) -> Result<Vec<FigureSpec>, ConfigError> {
+    // Two figures of one name would overwrite each other's file.
+    let names = RefCell::new(Vec::new());
     KINDS.read_list(section, space, benchmark, |item| {
-        figure(item, space, measures)
+        figure(item, space, measures, &names)
     })
+}
+
+/// The longest `name`: with a variant and `.png` it stays well inside a file name.
+const NAME_MAX: usize = 60;
+
+/// A figure's `name`: its file stem, so letters, digits, `.`, `-` and `_` only.
+fn figure_name(node: &Node, field: &str) -> Result<String, ConfigError> {
+    let name = node.as_text(field)?;
+    let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_');
+    if name.is_empty() || name.len() > NAME_MAX || !name.chars().all(allowed) {
+        return Err(node.expected(
+            field,
+            &format!("a file stem of 1 to {NAME_MAX} letters, digits, '.', '-' or '_'"),
+        ));
+    }
+    Ok(name.to_string())
+}
+
+/// Text that says something: `title` and `paper`.
+fn text(node: &Node, field: &str) -> Result<String, ConfigError> {
+    let text = node.as_text(field)?.trim();
+    if text.is_empty() {
+        return Err(node.expected(field, "non-empty text"));
+    }
+    Ok(text.to_string())
 }
 
 fn figure(
     item: Item<FigureKind>,
     space: &ParamSpace,
     measures: Measures,
+    names: &RefCell<Vec<String>>,
 ) -> Result<FigureSpec, ConfigError> {
     let Item {
         node,
@@ -83,7 +114,28 @@ fn figure(
         }
         (None, _) => None,
     };
+    let given = |key: &str, read: fn(&Node, &str) -> Result<String, ConfigError>| {
+        find(&entries, key)
+            .map(|e| Ok((read(e.value, &child_field(parent, key))?, e.value.pos)))
+            .transpose()
+    };
+    let name = given("name", figure_name)?;
+    if let Some((name, pos)) = &name {
+        let mut names = names.borrow_mut();
+        if names.contains(name) {
+            return Err(ConfigError::at(
+                *pos,
+                child_field(parent, "name"),
+                format!("another figure is named '{name}' already; each needs its own"),
+            ));
+        }
+        names.push(name.clone());
+    }
+    let text_of = |key| Ok::<_, ConfigError>(given(key, text)?.map(|(t, _)| t));
     Ok(FigureSpec {
+        name: name.map(|(name, _)| name),
+        title: text_of("title")?,
+        paper: text_of("paper")?,
         kind: kind.clone(),
         fields,
         norm: norm(&entries, parent, measures)?,

@@ -15,6 +15,8 @@ pub(crate) struct Kinds<K: 'static> {
     pub kinds: &'static [(&'static str, K)],
     /// `kind` and every key of `takes` of any kind.
     pub keys: &'static [&'static str],
+    /// Keys every kind takes (a figure's `name`, `title`, `paper`).
+    pub common: &'static [&'static str],
     pub takes: fn(&K) -> &'static [&'static str],
     pub suits: fn(&K, BenchmarkKind) -> bool,
 }
@@ -40,7 +42,8 @@ impl<K> Kinds<K> {
     ) -> Result<Vec<T>, ConfigError> {
         read_list(section, |node, parent| {
             let entries = node.entries(parent)?;
-            let select = selection(&entries, parent, space, self.keys)?;
+            let own: Vec<&str> = self.keys.iter().chain(self.common).copied().collect();
+            let select = selection(&entries, parent, space, &own)?;
             let kind = self.kind(&entries, node, parent, benchmark)?;
             self.reject_others_keys(&entries, kind, parent)?;
             read(Item {

@@ -204,6 +204,13 @@ pub enum FigureKind {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct FigureSpec {
+    /// The file stem: `figures/<name>.png`, `<name>_<variant>.png` for each of several figures
+    /// the item draws; without it a stem from the experiment and the figure's scope.
+    pub name: Option<String>,
+    /// What the figure shows, and `paper` the figure it reproduces ("Gong 2015, Fig 4.7"):
+    /// together the caption, in place of one made from the axes.
+    pub title: Option<String>,
+    pub paper: Option<String>,
     pub kind: FigureKind,
     pub fields: Vec<String>,
     pub norm: String,

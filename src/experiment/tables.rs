@@ -38,6 +38,7 @@ const KINDS: Kinds<TableKind> = Kinds {
         "after",
         "tolerance",
     ],
+    common: &[],
     takes,
     suits: lists_for,
 };

@@ -52,6 +52,18 @@ pub fn fit_loglog(points: &[(f64, f64)]) -> Option<LineFit> {
     })
 }
 
+/// The log-log slope between successive points in order of decreasing h (points of equal h
+/// give none).
+pub fn segment_slopes(points: &[(f64, f64)]) -> Vec<f64> {
+    let mut sorted = points.to_vec();
+    sorted.sort_by(|a, b| b.0.total_cmp(&a.0));
+    sorted
+        .windows(2)
+        .filter(|w| w[0].0 != w[1].0)
+        .map(|w| (w[1].1 / w[0].1).log10() / (w[1].0 / w[0].0).log10())
+        .collect()
+}
+
 /// Smallest and largest of `values` (infinities when there are none).
 pub fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
     values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -98,5 +110,15 @@ mod tests {
         assert_eq!(fit_loglog(&[]), None);
         assert_eq!(fit_loglog(&[(0.1, 1e-3)]), None);
         assert_eq!(fit_loglog(&[(0.1, 1e-3), (0.1, 2e-3)]), None);
+    }
+
+    #[test]
+    fn segments_show_a_floor_the_fit_hides() {
+        // Second order, then flat: h = 0.1, 0.05 in any order, then a floor at 0.025.
+        let points = [(0.05, 2.5e-3), (0.1, 1e-2), (0.025, 2.5e-3)];
+        let slopes = segment_slopes(&points);
+        assert_eq!(slopes.len(), 2);
+        assert!((slopes[0] - 2.0).abs() < 1e-12, "{slopes:?}");
+        assert!(slopes[1].abs() < 1e-12, "{slopes:?}");
     }
 }

@@ -91,18 +91,23 @@ pub fn label<K: Display, V: Display>(pairs: impl IntoIterator<Item = (K, V)>) ->
 /// `select` lists when it lists several, so that figures of two such selections tell
 /// themselves apart (`G=0.1 method=mpm_musl|mpm_tls`). A one-value selection adds nothing.
 pub fn scoped_label(group: &Params, select: &Selection) -> String {
-    let mut pairs: BTreeMap<&str, String> = group
+    label(scoped_pairs(group, select))
+}
+
+/// The (axis, value) pairs of `scoped_label`, sorted by axis.
+pub fn scoped_pairs(group: &Params, select: &Selection) -> Vec<(String, String)> {
+    let mut pairs: BTreeMap<String, String> = group
         .iter()
-        .map(|(k, v)| (k.as_str(), v.to_string()))
+        .map(|(k, v)| (k.clone(), v.to_string()))
         .collect();
     for (axis, allowed) in select {
         if allowed.values().len() > 1 {
             pairs
-                .entry(axis.as_str())
+                .entry(axis.clone())
                 .or_insert_with(|| allowed.to_string());
         }
     }
-    label(pairs)
+    pairs.into_iter().collect()
 }
 
 /// A group's label for titles and file names, `all` for a group without axes.

@@ -182,9 +182,13 @@ fn rates_table(md: &mut String, rates: &[RateRow]) {
         md,
         "Least-squares slope of log10(final error) against log10(h), over the runs that finished; \
          relative errors (norms `integral` and `reference`) at or below {RELATIVE_ROUND_OFF:e} \
-         are round-off and left out of the fit.\n"
+         are round-off and left out of the fit. The segments are the slopes between successive \
+         runs from the coarsest h to the finest.\n"
     );
-    let header = ["group", "field", "norm", "rate", "r2", "points", "h range"].map(String::from);
+    let header = [
+        "group", "field", "norm", "rate", "r2", "points", "h range", "segments",
+    ]
+    .map(String::from);
     let rows = rates.iter().map(|r| {
         vec![
             if r.group.is_empty() {
@@ -198,6 +202,11 @@ fn rates_table(md: &mut String, rates: &[RateRow]) {
             format!("{:.3}", r.r2),
             r.n.to_string(),
             format!("{} to {}", h_text(r.h_min), h_text(r.h_max)),
+            r.segments
+                .iter()
+                .map(|&s| rate(s))
+                .collect::<Vec<_>>()
+                .join(", "),
         ]
     });
     table(md, &header, rows);

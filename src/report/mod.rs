@@ -16,6 +16,7 @@ mod probe_table;
 pub mod stability;
 mod style;
 mod tables;
+mod units;
 
 use std::fs;
 use std::io;
@@ -46,6 +47,9 @@ pub struct RateRow {
     pub n: usize,
     pub h_min: f64,
     pub h_max: f64,
+    /// The slope between each pair of successive points from the coarsest h to the finest:
+    /// where the fit hides a bend or a floor.
+    pub segments: Vec<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -117,6 +121,7 @@ pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
                     continue;
                 };
                 let (h_min, h_max) = fit::min_max(points.iter().map(|p| p.0));
+                let segments = fit::segment_slopes(&points);
                 rows.push(RateRow {
                     experiment: experiment.name.clone(),
                     group: g.label.clone(),
@@ -129,6 +134,7 @@ pub fn fit_rates(experiment: &Experiment, runs: &[RunSummary]) -> Vec<RateRow> {
                     n: points.len(),
                     h_min,
                     h_max,
+                    segments,
                 });
             }
         }

@@ -42,6 +42,11 @@ const DOT_SPACING: i32 = 5;
 const DOT_RADIUS: i32 = 1;
 /// A line without markers of its own that needs them to be told apart carries this many.
 const MARKS_PER_LINE: usize = 8;
+/// A figure's notes under the legend: their font size, row height and the characters that
+/// fit one row.
+const NOTE_FONT: u32 = 14;
+const NOTE_ROW: u32 = 19;
+const NOTE_CHARS: usize = 95;
 
 /// The caption's font size: 22 px, smaller for a title that would not fit the width at 22 px
 /// (DejaVu Sans Bold averages about 0.62 em per character), but never below 12 px.
@@ -72,13 +77,21 @@ type DrawResult = Result<(), Box<dyn std::error::Error>>;
 fn draw(path: &Path, figure: &Figure) -> DrawResult {
     let columns = legend_columns(figure);
     let rows = figure.series.len().div_ceil(columns) as u32;
-    let height = AXES_HEIGHT + rows * LEGEND_ROW + MARGIN / 2;
+    let notes: Vec<String> = figure
+        .notes
+        .iter()
+        .flat_map(|n| wrap(n, NOTE_CHARS))
+        .collect();
+    let legend_height = rows * LEGEND_ROW;
+    let height = AXES_HEIGHT + legend_height + notes.len() as u32 * NOTE_ROW + MARGIN / 2;
     let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
     root.fill(&WHITE)?;
-    let (axes, legend) = root.split_vertically(AXES_HEIGHT);
+    let (axes, below) = root.split_vertically(AXES_HEIGHT);
+    let (legend, note_area) = below.split_vertically(legend_height);
     let styles = style::assign(&figure.series);
     draw_axes(&axes, figure, &styles)?;
     draw_legend(&legend, figure, &styles, columns)?;
+    draw_notes(&note_area, &notes)?;
     root.present()?;
     Ok(())
 }
@@ -87,7 +100,7 @@ fn draw_axes(area: &Area, figure: &Figure, styles: &[Style]) -> DrawResult {
     let data: Vec<(f64, f64)> = figure
         .series
         .iter()
-        .flat_map(|s| s.markers.iter().chain(&s.line).copied())
+        .flat_map(|s| s.markers.iter().chain(&s.line).chain(&s.fit).copied())
         .collect();
     let xs = data.iter().map(|p| p.0);
     let ys = data.iter().map(|p| p.1);
@@ -175,6 +188,10 @@ where
         let shape = shape_style(style);
         if let (Some(pattern), false) = (style.line, series.line.is_empty()) {
             chart.draw_series([path(series.line.clone(), pattern, shape)])?;
+        }
+        if !series.fit.is_empty() {
+            let thin = shape.stroke_width(1);
+            chart.draw_series([path(series.fit.clone(), Pattern::Dashed, thin)])?;
         }
         if let Some(marker) = style.marker {
             let points = if series.markers.is_empty() {
@@ -330,6 +347,40 @@ fn draw_legend(area: &Area, figure: &Figure, styles: &[Style], columns: usize) -
     Ok(())
 }
 
+/// The notes in grey, one row each, from the plot's left edge.
+fn draw_notes(area: &Area, rows: &[String]) -> DrawResult {
+    let left = (MARGIN + Y_LABEL_AREA) as i32;
+    let font = TextStyle::from((FONT, NOTE_FONT).into_font())
+        .color(&RGBColor(80, 80, 80))
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    for (i, row) in rows.iter().enumerate() {
+        let y = (i as u32 * NOTE_ROW + NOTE_ROW / 2) as i32;
+        area.draw(&Text::new(row.clone(), (left, y), font.clone()))?;
+    }
+    Ok(())
+}
+
+/// `text` broken at spaces into rows of at most `width` characters (a longer word is a row
+/// of its own), the rows after the first indented.
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut rows: Vec<String> = Vec::new();
+    let mut row = String::new();
+    for word in text.split_whitespace() {
+        if !row.is_empty() && row.chars().count() + 1 + word.chars().count() > width {
+            rows.push(std::mem::take(&mut row));
+            row.push_str("  ");
+        }
+        if !row.trim().is_empty() {
+            row.push(' ');
+        }
+        row.push_str(word);
+    }
+    if !row.trim().is_empty() {
+        rows.push(row);
+    }
+    rows
+}
+
 /// The series' look as drawn on the axes: its line across the glyph in its pattern, its
 /// marker over the middle.
 fn draw_glyph(area: &Area, style: &Style, (x, y): (i32, i32)) -> DrawResult {
@@ -460,6 +511,13 @@ mod tests {
         assert_eq!(padded_linear_range([0.0, 0.0].into_iter()), (-0.1, 0.1));
         let (lo, hi) = padded_linear_range([-1.0, f64::NAN, 1.0].into_iter());
         assert!((lo + 1.1).abs() < 1e-12 && (hi - 1.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn notes_wrap_at_spaces() {
+        assert_eq!(wrap("a bb ccc", 4), ["a bb", "  ccc"]);
+        assert_eq!(wrap("", 4), Vec::<String>::new());
+        assert_eq!(wrap("abcdefg hi", 4), ["abcdefg", "  hi"]);
     }
 
     #[test]

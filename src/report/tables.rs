@@ -97,6 +97,7 @@ pub fn figure_csv(figure: &Figure) -> String {
         };
         let mut rows = points("marker", &s.markers);
         rows.extend(points("line", &s.line));
+        rows.extend(points("fit", &s.fit));
         rows
     });
     csv(&header, rows)

@@ -1,10 +1,11 @@
 //! Fields along the bar at the final time (Wobbes Fig 4): one line per run against the
 //! current position x, the experiment's reference run as grey markers.
 
-use super::{Figure, Names, Scale, Series};
+use super::{default_stem, Figure, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec, Selection};
 use crate::output::{Profile, RunStatus, RunSummary};
 use crate::report::group::{label, ordered_runs, selects};
+use crate::report::units::quantity;
 
 /// At most this many reference markers are drawn (every k-th point of the reference).
 const MAX_MARKERS: usize = 80;
@@ -16,7 +17,6 @@ pub(super) fn figures(
     all: &[RunSummary],
     selected: &[&RunSummary],
     spec: &FigureSpec,
-    names: &mut Names,
 ) -> Vec<Figure> {
     let reference_axes = experiment.reference.as_ref().map(Selection::from);
     let is_reference = |run: &RunSummary| {
@@ -38,7 +38,7 @@ pub(super) fn figures(
             .iter()
             .filter_map(|run| {
                 let points = along(run.profile.as_ref()?, field);
-                Some(Series::line(label(&run.axes), points))
+                Some(Series::line(differing(&lines, run), points))
             })
             .collect();
         if let Some(run) = reference {
@@ -60,15 +60,33 @@ pub(super) fn figures(
         }
         let what = format!("{field}_along_bar_{}", label(&spec.select));
         figures.push(Figure {
-            file: names.file(experiment, &what),
+            file: default_stem(&what),
             title: format!("{}: {field} at the final time", experiment.name),
-            x_label: "x (current position)".into(),
-            y_label: field.clone(),
+            variant: vec![("field".into(), field.clone())],
+            x_label: "x, current position (m)".into(),
+            y_label: quantity(field),
             scale: Scale::Linear,
             series,
+            notes: Vec::new(),
         });
     }
     figures
+}
+
+/// A line's label: the axis values that tell its run from the figure's other lines (all of
+/// them for a figure of one line).
+fn differing(lines: &[&RunSummary], run: &RunSummary) -> String {
+    let varies = |axis: &String| {
+        lines
+            .iter()
+            .any(|other| other.axes.get(axis) != run.axes.get(axis))
+    };
+    let pairs: Vec<_> = run.axes.iter().filter(|(axis, _)| varies(axis)).collect();
+    if pairs.is_empty() {
+        label(&run.axes)
+    } else {
+        label(pairs)
+    }
 }
 
 /// (x_p, f_p) in order of x.

@@ -2,12 +2,12 @@
 //! the benchmark's reference drawn once in grey. A diverged run's line stops where it did,
 //! marked with a cross.
 
-use super::{Figure, Marker, Names, Scale, Series};
+use super::{default_stem, Figure, Marker, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec};
 use crate::output::{ProbeRecord, RunStatus, RunSummary};
 use crate::report::format::general;
 use crate::report::group::{
-    group_runs, label, label_or_all, recorded_probes, scoped_label, title_suffix,
+    group_runs, label, label_or_all, recorded_probes, scoped_pairs, title_suffix,
 };
 
 /// Names of the components of vectors and tensors, by index.
@@ -22,7 +22,6 @@ pub(super) fn figures(
     experiment: &Experiment,
     runs: &[&RunSummary],
     spec: &FigureSpec,
-    names: &mut Names,
 ) -> Result<Vec<Figure>, String> {
     let Some(name) = spec.probe.as_deref() else {
         return Ok(Vec::new());
@@ -51,15 +50,18 @@ pub(super) fn figures(
         if let Some(reference) = reference(&probes) {
             series.push(reference);
         }
-        let scope = scoped_label(&group.axes, &spec.select);
+        let variant = scoped_pairs(&group.axes, &spec.select);
+        let scope = label(variant.iter().map(|(k, v)| (k, v)));
         let which = format!("{name}_{}", label_or_all(&scope));
         figures.push(Figure {
-            file: names.file(experiment, &which),
+            file: default_stem(&which),
             title: format!("{}: {name}{}", experiment.name, title_suffix(&scope)),
-            x_label: "t (s)".into(),
+            variant,
+            x_label: "t, time (s)".into(),
             y_label: quantity_label(first),
             scale: Scale::Linear,
             series,
+            notes: Vec::new(),
         });
     }
     Ok(figures)

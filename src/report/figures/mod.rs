@@ -3,6 +3,7 @@
 mod along_bar;
 mod convergence;
 mod history;
+mod overlap;
 mod profiles;
 mod shape_functions;
 mod stability;
@@ -10,7 +11,7 @@ mod stability;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
-use super::group::{selects, slug};
+use super::group::{label, selects, slug};
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
 use crate::output::RunSummary;
@@ -57,6 +58,8 @@ pub struct Series {
     pub line: Vec<(f64, f64)>,
     /// A fit or a bound: the line is dashed (dotted to tell it from another), never solid.
     pub dashed: bool,
+    /// A law fitted to the markers, drawn dashed in the series' colour.
+    pub fit: Vec<(f64, f64)>,
     /// Drawn in grey whatever its place: a reference the other series are judged against.
     pub neutral: bool,
 }
@@ -69,6 +72,7 @@ impl Series {
             marker,
             line: Vec::new(),
             dashed: false,
+            fit: Vec::new(),
             neutral: false,
         }
     }
@@ -80,6 +84,7 @@ impl Series {
             marker: Marker::Circle,
             line: points,
             dashed: false,
+            fit: Vec::new(),
             neutral: false,
         }
     }
@@ -87,13 +92,20 @@ impl Series {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Figure {
-    /// Relative to the report directory.
+    /// Relative to the report directory. A kind's module gives the stem the file gets when
+    /// its `figures` item names none (`default_stem`); `plan` names the file.
     pub file: PathBuf,
     pub title: String,
+    /// The axis values (and for some kinds the quantity) that tell this figure from the
+    /// others its `figures` item draws; `plan` names the figure by those that differ.
+    pub variant: Vec<(String, String)>,
     pub x_label: String,
     pub y_label: String,
     pub scale: Scale,
     pub series: Vec<Series>,
+    /// Lines under the legend: what the series do not show by themselves (the fits'
+    /// pattern, runs that did not finish).
+    pub notes: Vec<String>,
 }
 
 /// Every figure of the report: the experiment's own, or when it asks for none one convergence
@@ -114,6 +126,9 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
         select: Selection::default(),
         stability: None,
         probe: None,
+        name: None,
+        title: None,
+        paper: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -127,33 +142,69 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
             .iter()
             .filter(|run| selects(&spec.select, &run.axes))
             .collect();
-        match spec.kind {
-            FigureKind::Convergence => figures.extend(convergence::figures(
-                experiment, &selected, spec, &mut names,
-            )),
+        let mut drawn = match spec.kind {
+            FigureKind::Convergence => convergence::figures(experiment, &selected, spec),
             FigureKind::Reconstruction => {
-                figures.extend(profiles::reconstructions(experiment, &selected, &mut names));
-                figures.extend(profiles::element_fits(experiment, &selected, &mut names));
+                let mut drawn = profiles::reconstructions(&selected);
+                drawn.extend(profiles::element_fits(&selected));
+                drawn
             }
-            FigureKind::Basis => figures.extend(profiles::bases(experiment, &selected, &mut names)),
-            FigureKind::Stability => figures.extend(stability::limit_figures(
-                experiment, &selected, spec, &mut names,
-            )),
-            FigureKind::Growth => figures.extend(stability::growth_figures(
-                experiment, &selected, spec, &mut names,
-            )),
-            FigureKind::Profile => figures.extend(along_bar::figures(
-                experiment, runs, &selected, spec, &mut names,
-            )),
-            FigureKind::ShapeFunctions => figures.extend(shape_functions::figures(
-                experiment, &selected, spec, &mut names,
-            )),
-            FigureKind::History => {
-                figures.extend(history::figures(experiment, &selected, spec, &mut names)?)
-            }
-        }
+            FigureKind::Basis => profiles::bases(&selected),
+            FigureKind::Stability => stability::limit_figures(experiment, &selected, spec),
+            FigureKind::Growth => stability::growth_figures(experiment, &selected, spec),
+            FigureKind::Profile => along_bar::figures(experiment, runs, &selected, spec),
+            FigureKind::ShapeFunctions => shape_functions::figures(&selected, spec),
+            FigureKind::History => history::figures(experiment, &selected, spec)?,
+        };
+        name(experiment, spec, &mut drawn, &mut names);
+        drawn.iter_mut().for_each(overlap::mark_coincident);
+        figures.extend(drawn);
     }
     Ok(figures)
+}
+
+/// The stem a figure's file gets when its item names none: `what` after the experiment.
+fn default_stem(what: &str) -> PathBuf {
+    PathBuf::from(slug(what))
+}
+
+/// Gives the figures one `spec` drew their files and, when it has a `title`, their captions:
+/// `<name>` for a single figure, `<name>_<variant>` for each of several, where the variant is
+/// the axis values that differ between them; the `paper` reference opens the caption.
+fn name(experiment: &Experiment, spec: &FigureSpec, drawn: &mut [Figure], names: &mut Names) {
+    let several = drawn.len() > 1;
+    let shared: Vec<(String, String)> = match drawn.split_first() {
+        Some((first, rest)) => first
+            .variant
+            .iter()
+            .filter(|pair| rest.iter().all(|f| f.variant.contains(pair)))
+            .cloned()
+            .collect(),
+        None => Vec::new(),
+    };
+    for figure in drawn.iter_mut() {
+        let distinct: Vec<&(String, String)> = figure
+            .variant
+            .iter()
+            .filter(|pair| !shared.contains(pair))
+            .collect();
+        let distinct = label(distinct.iter().map(|(k, v)| (k, v)));
+        let stem = match &spec.name {
+            Some(name) if several && !distinct.is_empty() => format!("{name}_{}", slug(&distinct)),
+            Some(name) => name.clone(),
+            None => format!("{}_{}", slug(&experiment.name), figure.file.display()),
+        };
+        figure.file = names.file(&stem);
+        if let Some(title) = &spec.title {
+            figure.title = match several && !distinct.is_empty() {
+                true => format!("{title} ({distinct})"),
+                false => title.clone(),
+            };
+        }
+        if let Some(paper) = &spec.paper {
+            figure.title = format!("{paper}: {}", figure.title);
+        }
+    }
 }
 
 /// File names already given out: two figures may land on the same stem, and later ones get
@@ -162,10 +213,9 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
 struct Names(BTreeSet<String>);
 
 impl Names {
-    /// `figures/<experiment>_<what>.png`, made unique.
-    fn file(&mut self, experiment: &Experiment, what: &str) -> PathBuf {
-        let stem = format!("{}_{}", slug(&experiment.name), slug(what));
-        let mut name = stem.clone();
+    /// `figures/<stem>.png`, made unique.
+    fn file(&mut self, stem: &str) -> PathBuf {
+        let mut name = stem.to_string();
         let mut k = 2;
         while !self.0.insert(name.clone()) {
             name = format!("{stem}_{k}");

@@ -2,19 +2,14 @@
 //! (Gong Figs 4.1-4.6, 5.1-5.2), u with each element's fit (Wobbes Figs 1-2), and the
 //! weighted orthogonal basis (Tran Figs 1-3).
 
-use super::{Figure, Marker, Names, Scale, Series};
-use crate::experiment::Experiment;
+use super::{default_stem, Figure, Marker, Scale, Series};
 use crate::output::{ReconstructionRecord, RunSummary};
 use crate::params::ParamValue;
 use crate::report::format::general;
 use crate::report::group::label;
 
 /// u(x) as a line, u^h at the nodes as circles, the data (x_p, u_p) as squares.
-pub(super) fn reconstructions(
-    experiment: &Experiment,
-    runs: &[&RunSummary],
-    names: &mut Names,
-) -> Vec<Figure> {
+pub(super) fn reconstructions(runs: &[&RunSummary]) -> Vec<Figure> {
     with_record(runs, |run, r| {
         let nodes: Vec<(f64, f64)> = pairs(&r.x, &r.reconstructed)
             .filter(|p| p.1.is_finite())
@@ -32,12 +27,14 @@ pub(super) fn reconstructions(
             ),
         ];
         Figure {
-            file: names.file(experiment, &format!("reconstruction_{}", label(&run.axes))),
+            file: default_stem(&format!("reconstruction_{}", label(&run.axes))),
             title: title(&format!("{}: u = {}", run.method, r.formula), run),
-            x_label: "x".into(),
-            y_label: "u".into(),
+            variant: pairs_of(run),
+            x_label: "x (dimensionless)".into(),
+            y_label: "u (dimensionless)".into(),
             scale: Scale::Linear,
             series,
+            notes: Vec::new(),
         }
     })
 }
@@ -45,11 +42,7 @@ pub(super) fn reconstructions(
 /// u as a line, each element's fit u^h as a line of its own (with the degree it settled on),
 /// and the data as squares: along x in 1D; in 2D along the line y = const through the middle
 /// of the middle row of elements, with the data on that line.
-pub(super) fn element_fits(
-    experiment: &Experiment,
-    runs: &[&RunSummary],
-    names: &mut Names,
-) -> Vec<Figure> {
+pub(super) fn element_fits(runs: &[&RunSummary]) -> Vec<Figure> {
     runs.iter()
         .filter_map(|run| {
             let r = run.elements.as_ref()?;
@@ -105,12 +98,14 @@ pub(super) fn element_fits(
                 None => String::new(),
             };
             Some(Figure {
-                file: names.file(experiment, &format!("elements_{}", label(&run.axes))),
+                file: default_stem(&format!("elements_{}", label(&run.axes))),
                 title: format!("{}: u = {}{at}, {elements} elements", run.method, r.formula),
-                x_label: "x".into(),
-                y_label: "u".into(),
+                variant: pairs_of(run),
+                x_label: "x (dimensionless)".into(),
+                y_label: "u (dimensionless)".into(),
                 scale: Scale::Linear,
                 series,
+                notes: Vec::new(),
             })
         })
         .filter(|figure| figure.series.iter().any(|s| !s.line.is_empty()))
@@ -118,11 +113,7 @@ pub(super) fn element_fits(
 }
 
 /// p_1 .. p_m as lines with the data points on them; a dropped polynomial says so.
-pub(super) fn bases(
-    experiment: &Experiment,
-    runs: &[&RunSummary],
-    names: &mut Names,
-) -> Vec<Figure> {
+pub(super) fn bases(runs: &[&RunSummary]) -> Vec<Figure> {
     with_record(runs, |run, r| {
         let basis = r.basis.as_ref()?;
         let (np, nc) = (r.data_x.len(), r.curve_x.len());
@@ -139,22 +130,25 @@ pub(super) fn bases(
                     marker: Marker::Circle,
                     line: pairs(&r.curve_x, &basis.curve_p[i * nc..(i + 1) * nc]).collect(),
                     dashed: false,
+                    fit: Vec::new(),
                     neutral: false,
                 }
             })
             .collect();
         Some(Figure {
-            file: names.file(experiment, &format!("basis_{}", label(&run.axes))),
+            file: default_stem(&format!("basis_{}", label(&run.axes))),
+            variant: pairs_of(run),
             title: format!(
                 "x_p = {}: {} weight at {}",
                 short_list(&r.data_x),
                 r.weight,
                 general(basis.centre, 4)
             ),
-            x_label: "x".into(),
-            y_label: "p_i(x)".into(),
+            x_label: "x (dimensionless)".into(),
+            y_label: "p_i(x) (dimensionless)".into(),
             scale: Scale::Linear,
             series,
+            notes: Vec::new(),
         })
     })
 }
@@ -205,4 +199,16 @@ fn title(what: &str, run: &RunSummary) -> String {
 fn short_list(values: &[f64]) -> String {
     let items: Vec<String> = values.iter().map(|&x| general(x, 4)).collect();
     items.join(", ")
+}
+
+/// A run's axis values, which tell its figure from the other runs', lists of points to four
+/// digits so that a file named by them stays short.
+fn pairs_of(run: &RunSummary) -> Vec<(String, String)> {
+    run.axes
+        .iter()
+        .map(|(k, v)| match v {
+            ParamValue::List(values) => (k.clone(), short_list(values)),
+            _ => (k.clone(), v.to_string()),
+        })
+        .collect()
 }

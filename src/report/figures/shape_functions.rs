@@ -1,11 +1,11 @@
 //! Shape-function figures (Molinos et al. Fig 3): N_a of the centre node and dN_a/dx along the
 //! line through it parallel to x (in 2D the section y = y_a), one curve per run, the hat in grey.
 
-use super::{Figure, Names, Scale, Series};
-use crate::experiment::{Experiment, FigureSpec};
+use super::{default_stem, Figure, Scale, Series};
+use crate::experiment::FigureSpec;
 use crate::output::{RunSummary, ShapeFunctionRecord};
 use crate::report::format::general;
-use crate::report::group::{group_runs, label_or_all, scoped_label, title_suffix};
+use crate::report::group::{group_runs, label, label_or_all, scoped_pairs, title_suffix};
 
 /// The basis drawn in grey, as the reference LME tends to for large gamma.
 const REFERENCE_BASIS: &str = "linear";
@@ -13,12 +13,7 @@ const REFERENCE_BASIS: &str = "linear";
 const METHOD_AXIS: &str = "method";
 
 /// Per group of the axes other than the method and `by`: a figure of N_a and one of dN_a/dx.
-pub(super) fn figures(
-    experiment: &Experiment,
-    selected: &[&RunSummary],
-    spec: &FigureSpec,
-    names: &mut Names,
-) -> Vec<Figure> {
+pub(super) fn figures(selected: &[&RunSummary], spec: &FigureSpec) -> Vec<Figure> {
     let mut drop = vec![METHOD_AXIS];
     drop.extend(spec.by.iter().map(String::as_str));
     let mut figures = Vec::new();
@@ -40,7 +35,8 @@ pub(super) fn figures(
         if runs.is_empty() {
             continue;
         }
-        let scope = scoped_label(&group.axes, &spec.select);
+        let pairs = scoped_pairs(&group.axes, &spec.select);
+        let scope = label(pairs.iter().map(|(k, v)| (k, v)));
         for (what, y_label, component) in [
             ("value", "N_a", None),
             ("gradient", "dN_a/dx (1/h)", Some(0)),
@@ -53,19 +49,20 @@ pub(super) fn figures(
                     s
                 })
                 .collect();
+            let mut variant = pairs.clone();
+            variant.push(("quantity".into(), what.into()));
             figures.push(Figure {
-                file: names.file(
-                    experiment,
-                    &format!("shape_functions_{what}_{}", label_or_all(&scope)),
-                ),
+                file: default_stem(&format!("shape_functions_{what}_{}", label_or_all(&scope))),
+                variant,
                 title: format!(
                     "{y_label} of the centre node along y = y_a{}",
                     title_suffix(&scope)
                 ),
-                x_label: "(x - x_a) / h".into(),
+                x_label: "(x - x_a) / h (dimensionless)".into(),
                 y_label: y_label.into(),
                 scale: Scale::Linear,
                 series,
+                notes: Vec::new(),
             });
         }
     }

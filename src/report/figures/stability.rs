@@ -1,11 +1,11 @@
 //! Figures of stability sweeps: the measured limit against `x` beside the predicted bounds,
 //! and the error histories of the two runs that bracket the limit.
 
-use super::{Figure, Marker, Names, Scale, Series};
+use super::{default_stem, Figure, Marker, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec, StabilityAxes};
 use crate::output::RunSummary;
 use crate::report::format::general;
-use crate::report::group::{group_runs, label_or_all, scoped_label};
+use crate::report::group::{group_runs, label, label_or_all, scoped_pairs};
 use crate::report::stability::{
     group_name, limits, outcome, particles_per_cell, predicted, Verdict, PPC_AXIS, THRESHOLD,
 };
@@ -17,7 +17,6 @@ pub(super) fn limit_figures(
     experiment: &Experiment,
     runs: &[&RunSummary],
     spec: &FigureSpec,
-    names: &mut Names,
 ) -> Vec<Figure> {
     let Some(StabilityAxes { sweep, x: Some(x) }) = &spec.stability else {
         return Vec::new();
@@ -47,17 +46,20 @@ pub(super) fn limit_figures(
                 Series::markers(format!("last stable {sweep}"), Marker::Circle, stable),
                 Series::markers(format!("first unstable {sweep}"), Marker::Square, unstable),
             ]);
-            let name = label_or_all(&scoped_label(&group.axes, &spec.select));
+            let variant = scoped_pairs(&group.axes, &spec.select);
+            let name = label_or_all(&label(variant.iter().map(|(k, v)| (k, v))));
             Some(Figure {
-                file: names.file(experiment, &format!("stability_{name}")),
+                file: default_stem(&format!("stability_{name}")),
+                variant,
                 title: format!(
                     "{}: stability limit along {sweep} ({name})",
                     experiment.name
                 ),
-                x_label: x.clone(),
-                y_label: format!("{sweep} (Courant number)"),
+                x_label: format!("{x} (dimensionless)"),
+                y_label: format!("{sweep} (Courant number, dimensionless)"),
                 scale: Scale::Linear,
                 series,
+                notes: Vec::new(),
             })
         })
         .collect()
@@ -90,7 +92,6 @@ pub(super) fn growth_figures(
     experiment: &Experiment,
     runs: &[&RunSummary],
     spec: &FigureSpec,
-    names: &mut Names,
 ) -> Vec<Figure> {
     let Some(StabilityAxes { sweep, .. }) = &spec.stability else {
         return Vec::new();
@@ -138,12 +139,18 @@ pub(super) fn growth_figures(
             series.push(threshold);
             let name = group_name(&limit.axes);
             Some(Figure {
-                file: names.file(experiment, &format!("growth_{name}")),
+                file: default_stem(&format!("growth_{name}")),
                 title: format!("{}: error growth at the limit ({name})", experiment.name),
-                x_label: "t (s)".into(),
-                y_label: "l2 velocity error / l2 velocity at t = 0".into(),
+                variant: limit
+                    .axes
+                    .iter()
+                    .map(|(k, v)| (k.clone(), v.to_string()))
+                    .collect(),
+                x_label: "t, time (s)".into(),
+                y_label: "l2 velocity error / l2 velocity at t = 0 (-)".into(),
                 scale: Scale::LogY,
                 series,
+                notes: Vec::new(),
             })
         })
         .collect()
