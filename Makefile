@@ -3,13 +3,14 @@
 #   make            (= make all) install what is missing, build, run every experiments/*.yaml
 #                   into results/<name>/ and write its report
 #   make test       lint, unit tests, reduced matrices in tests/matrices/, `mpmlab report
-#                   --check` on each reduced matrix, HDF5 layout test, then test-slurm
+#                   --check` on each reduced matrix, HDF5 layout and XDMF tests, then test-slurm
 #   make test-slurm the reduced matrices as a Slurm array on a one-node cluster started for
 #                   the test (installs slurm and munge when missing), compared bit for bit
 #                   with a single-machine run
 #   make bench      particle-steps per second per method and dimension
 #   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
-#   make clean-results   delete generated HDF5 run files (reports and figures stay)
+#   make clean-results   delete generated HDF5 run files and their XDMF descriptions
+#                   (reports and figures stay)
 #
 # Variables: JOBS=N (parallel runs, default: all cores), FORCE=1 (re-run complete runs),
 # RESULTS=DIR (output of `make all`, default results), PYTHON=python3 (to create .venv).
@@ -151,5 +152,6 @@ bench: deps-system
 clean-results:
 	@$(SH_LIB)
 	if [ -d "$(RESULTS)" ]; then
-	  find "$(RESULTS)" -type f \( -name '*.h5' -o -name '*.h5.tmp*' \) -print -delete
+	  find "$(RESULTS)" -type f \( -name '*.h5' -o -name '*.h5.tmp*' -o -name '*.xdmf' \
+	    -o -name '*.xdmf.tmp*' \) -print -delete
 	fi

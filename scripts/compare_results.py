@@ -6,7 +6,8 @@ For every experiment directory of A (one with an experiment.yaml) B must have th
 experiment.yaml, the same run files and no temporary files left, and every pair of run files
 must hold the same groups, datasets and attributes: every dataset with the same dtype, shape
 and bytes, every attribute equal. Excluded, because it records time: the root attribute
-`wall_seconds` of each run file (and timings.csv, which is not compared). The report files
+`wall_seconds` of each run file (and timings.csv, which is not compared). B must have the same
+XDMF descriptions (<run_id>.xdmf), byte for byte. The report files
 (summary.csv, rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
 Exits 1 listing the differences.
 """
@@ -48,6 +49,16 @@ def contents(path):
     return items
 
 
+def common_runs_files(a, b, pattern, what, problems):
+    """The names matching `pattern` in both runs/ directories; a problem when the sets differ."""
+    names_a = {p.name for p in (a / "runs").glob(pattern)}
+    names_b = {p.name for p in (b / "runs").glob(pattern)}
+    if names_a != names_b:
+        only_a, only_b = sorted(names_a - names_b), sorted(names_b - names_a)
+        problems.append(f"{a.name}: {what} differ: only in A {only_a}, only in B {only_b}")
+    return sorted(names_a & names_b)
+
+
 def compare_experiment(a, b, problems, counts):
     name = a.name
     if not (b / "experiment.yaml").is_file():
@@ -59,13 +70,7 @@ def compare_experiment(a, b, problems, counts):
         leftovers = [p.name for p in (d / "runs").glob(".*")]
         if leftovers:
             problems.append(f"{d}: temporary files left: {leftovers}")
-    runs_a = sorted(p.name for p in (a / "runs").glob("*.h5"))
-    runs_b = sorted(p.name for p in (b / "runs").glob("*.h5"))
-    if runs_a != runs_b:
-        only_a = sorted(set(runs_a) - set(runs_b))
-        only_b = sorted(set(runs_b) - set(runs_a))
-        problems.append(f"{name}: run files differ: only in A {only_a}, only in B {only_b}")
-    for run in sorted(set(runs_a) & set(runs_b)):
+    for run in common_runs_files(a, b, "*.h5", "run files", problems):
         ca, cb = contents(a / "runs" / run), contents(b / "runs" / run)
         if ca.keys() != cb.keys():
             diff = sorted(set(ca) ^ set(cb))
@@ -76,6 +81,11 @@ def compare_experiment(a, b, problems, counts):
         counts["runs"] += 1
         counts["datasets"] += sum(1 for k in ca if k[1] == "dataset")
         counts["attributes"] += sum(1 for k in ca if k[1] == "attr")
+    for xdmf in common_runs_files(a, b, "*.xdmf", "XDMF files", problems):
+        if (a / "runs" / xdmf).read_bytes() != (b / "runs" / xdmf).read_bytes():
+            problems.append(f"{name}/{xdmf} differs")
+        else:
+            counts["descriptions"] += 1
     for report in ["summary.csv", "rates.csv", "report.md"] + sorted(
         str(p.relative_to(a)) for p in a.glob("figures/*.png")
     ):
@@ -97,7 +107,7 @@ def main(argv):
     if not experiments:
         sys.exit(f"{a}: no experiment directories")
     problems = []
-    counts = {"runs": 0, "datasets": 0, "attributes": 0, "report files": 0}
+    counts = {"runs": 0, "datasets": 0, "attributes": 0, "descriptions": 0, "report files": 0}
     for experiment in experiments:
         compare_experiment(experiment, b / experiment.name, problems, counts)
     for problem in problems[:50]:
@@ -105,7 +115,8 @@ def main(argv):
     print(
         f"{len(experiments)} experiments, {counts['runs']} run files: {counts['datasets']} "
         f"datasets and {counts['attributes']} attributes compared bit for bit (excluded: the "
-        f"root attribute wall_seconds), {counts['report files']} report files byte for byte: "
+        f"root attribute wall_seconds), {counts['descriptions']} XDMF descriptions and "
+        f"{counts['report files']} report files byte for byte: "
         + ("identical" if not problems else f"{len(problems)} differences")
     )
     return 1 if problems else 0

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::benchmarks::AnyProblem;
 use crate::experiment::{Experiment, RunSpec};
-use crate::output::{run_path, write_run, RunStatus};
+use crate::output::{describe_if_missing, run_path, write_run, RunStatus};
 use crate::params::get_usize;
 use crate::solver::simulate;
 
@@ -50,6 +50,10 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
         .runs
         .iter()
         .partition(|run| options.force || !run_path(&dir, &run.run_id).exists());
+    // A skipped run still gets the XDMF description it lacks.
+    for run in &done {
+        describe_if_missing(&run_path(&dir, &run.run_id))?;
+    }
     let mut todo = todo;
     // Longest first, so the pool does not end waiting on one large run.
     todo.sort_by_cached_key(|run| std::cmp::Reverse(estimated_cost(run)));

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use mpmlab::collect::collect;
 use mpmlab::experiment;
-use mpmlab::output::{run_path, RunStatus};
+use mpmlab::output::{run_path, xdmf_path, RunStatus};
 use mpmlab::report;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions};
 
@@ -87,9 +87,14 @@ fn runs_are_reproducible_skipped_and_divergence_is_recorded() {
         );
     }
 
-    // A rerun skips complete runs; --force redoes them bit for bit.
+    // A rerun skips complete runs, writing the XDMF description a run lacks; --force redoes
+    // them bit for bit.
+    let description = xdmf_path(&run_path(&dir_a, &exp.runs[0].run_id));
+    let text = std::fs::read(&description).unwrap();
+    std::fs::remove_file(&description).unwrap();
     let again = run_experiment(&exp, &options(&a, 1, false)).unwrap();
     assert_eq!((again.written, again.skipped), (0, 2));
+    assert_eq!(std::fs::read(&description).unwrap(), text);
     let before: Vec<_> = exp
         .runs
         .iter()

@@ -198,8 +198,9 @@ mod reconstruction;
 mod record;
 mod shape_functions;
 mod writer;
+mod xdmf;
 
-pub use atomic::{run_path, write_atomically, write_run};
+pub use atomic::{describe_if_missing, run_path, write_atomically, write_run};
 pub use elements::ElementRecord;
 pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
 pub use reader::{read_probes, read_profile, read_summary};
@@ -209,3 +210,5 @@ pub use record::{
 };
 pub use shape_functions::ShapeFunctionRecord;
 pub use writer::write_hdf5;
+pub use xdmf::xdmf_path;
+use xdmf::{write_xdmf, HistoryLayout};

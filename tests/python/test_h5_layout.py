@@ -116,8 +116,9 @@ def test_run_files_present():
 
 
 def test_no_leftover_files_in_runs_dirs():
-    """Run files are written under a temporary name and renamed when complete, so a finished
-    `mpmlab run` leaves nothing but <run_id>.h5 in each runs/ directory."""
+    """Run files and their XDMF descriptions are written under a temporary name and renamed
+    when complete, so a finished `mpmlab run` leaves nothing but <run_id>.h5 and
+    <run_id>.xdmf in each runs/ directory."""
     root = _results_root()
     if root is None or not root.is_dir():
         pytest.fail(f"{ENV} is not set or not a directory")
@@ -126,7 +127,7 @@ def test_no_leftover_files_in_runs_dirs():
         for runs in root.rglob("runs")
         if runs.is_dir()
         for p in runs.iterdir()
-        if not (p.is_file() and p.suffix == ".h5")
+        if not (p.is_file() and p.suffix in (".h5", ".xdmf"))
     ]
     assert not stray, f"unexpected entries in runs/ directories: {stray}"
 
