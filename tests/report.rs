@@ -117,6 +117,7 @@ fn experiment(expect: Vec<Expectation>, figures: Vec<FigureSpec>) -> Experiment 
         expect,
         figures,
         tables: Vec::new(),
+        paper_claims: Vec::new(),
         reference: None,
         runs: Vec::new(),
     }

@@ -8,7 +8,7 @@ use super::values::{pick, positive_int};
 use super::yaml::{find, reject_unknown_keys, require, Entry, Node, NodeKind};
 use super::OutputSpec;
 
-const TOP_LEVEL_KEYS: [&str; 10] = [
+const TOP_LEVEL_KEYS: [&str; 11] = [
     "name",
     "description",
     "benchmark",
@@ -19,6 +19,7 @@ const TOP_LEVEL_KEYS: [&str; 10] = [
     "figures",
     "tables",
     "reference",
+    "paper_claims",
 ];
 
 /// The top-level entries, all of known keys.

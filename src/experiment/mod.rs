@@ -1,6 +1,7 @@
 //! Experiment files: the YAML schema, validation with file/line/column errors, matrix
 //! expansion and stable run ids. Knows nothing of HDF5 or numerics.
 
+mod claims;
 mod document;
 mod error;
 mod expand;
@@ -60,6 +61,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let expect = expect::read(sections.get("expect"), &space, measures)?;
     let figures = figures::read(sections.get("figures"), &space, kind, measures)?;
     let tables = tables::read(sections.get("tables"), &space, kind, measures)?;
+    let paper_claims = claims::read(sections.get("paper_claims"), &space, measures, &figures)?;
     let runs = expand::expand(&name, &benchmark, &space, output.every)?;
     if let (Some(select), Some(section)) = (&reference, sections.get("reference")) {
         reference::check_unique(select, &runs, section)?;
@@ -76,6 +78,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
         expect,
         figures,
         tables,
+        paper_claims,
         reference,
         runs,
     })
@@ -98,6 +101,7 @@ pub struct Experiment {
     pub output: OutputSpec,
     pub expect: Vec<Expectation>,
     pub figures: Vec<FigureSpec>,
+    pub paper_claims: Vec<PaperClaim>,
     pub tables: Vec<TableSpec>,
     /// Axis values of the run the others are compared with at the final time (`reference`).
     pub reference: Option<Params>,
@@ -155,6 +159,35 @@ pub struct Expectation {
     pub limit: Option<LimitBound>,
     /// Line of the entry in the source file, for messages.
     pub line: usize,
+}
+
+/// One `paper_claims` entry: the paper's number for a field and norm of the selected runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaperClaim {
+    /// The paper's figure or table, e.g. "Gong 2015, Fig 4.7".
+    pub item: String,
+    /// What the paper says, in a few words.
+    pub claim: String,
+    /// The `name` of the figure of this experiment that shows it.
+    pub figure: Option<String>,
+    /// The runs that measure it: one fitted group for a rate, the runs of one error.
+    pub select: Selection,
+    pub field: String,
+    pub norm: String,
+    pub value: ClaimedValue,
+    /// A rate's absolute tolerance; an error's relative one.
+    pub tolerance: f64,
+    /// Where docs/NOTES.md isolates why ours differs, for a claim ours does not reproduce.
+    pub differs: Option<String>,
+    pub line: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClaimedValue {
+    /// A convergence rate: the slope of log error against log h.
+    Rate(f64),
+    /// A final error in the claim's norm.
+    Error(f64),
 }
 
 /// The measured stability limit along `sweep` must lie in [min, max]: in every group of the

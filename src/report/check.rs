@@ -3,6 +3,7 @@
 
 use std::fmt;
 
+use super::claims;
 use super::format::{exact, general};
 use super::group::{label, ordered_runs, selects};
 use super::stability::{group_name, limits};
@@ -24,7 +25,9 @@ impl fmt::Display for CheckFailure {
     }
 }
 
-/// Evaluates every `expect` entry; an empty vector means all passed.
+/// Evaluates every `expect` entry and every paper claim; an empty vector means all passed.
+/// A claim fails when ours leaves its tolerance without a `differs` note, when the note says
+/// it differs but ours is within, and when no run measures it.
 ///
 /// Rate bounds apply to every fitted rate whose group matches the selector, and fail when
 /// none does. `error_min` and `error_max` apply to every run whose axes match the selector
@@ -43,6 +46,7 @@ pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) ->
                 message,
             })
         })
+        .chain(claims::failures(&claims::evaluate(experiment, rates, runs)))
         .collect()
 }
 

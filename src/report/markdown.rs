@@ -4,6 +4,7 @@
 use std::fmt::Write;
 
 use super::check::{describe, CheckFailure};
+use super::claims::{claim_figures, Outcome};
 use super::figures::Figure;
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
@@ -19,6 +20,7 @@ pub fn report_md(
     rates: &[RateRow],
     tables: &[Table],
     figures: &[Figure],
+    claims: &[Outcome],
     check: Option<&[CheckFailure]>,
 ) -> String {
     let runs = ordered_runs(runs);
@@ -35,6 +37,7 @@ pub fn report_md(
         rates_table(&mut md, rates);
     }
     unfinished(&mut md, experiment, &runs);
+    claims_table(&mut md, claims, figures);
     if !tables.is_empty() {
         md.push_str("## Tables\n\n");
         for t in tables {
@@ -234,6 +237,53 @@ fn unfinished(md: &mut String, experiment: &Experiment, runs: &[&RunSummary]) {
             label(&run.axes),
             run.status.as_str().to_string(),
             run.message.clone(),
+        ]
+    });
+    table(md, &header, rows);
+}
+
+/// The papers' numbers beside ours (`paper_claims`), each with its figures.
+fn claims_table(md: &mut String, claims: &[Outcome], figures: &[Figure]) {
+    if claims.is_empty() {
+        return;
+    }
+    md.push_str(
+        "## Paper claims\n\nEach number the papers state, beside what the runs measure for it: \
+         reproduced when every measured value is within the tolerance (absolute for a rate, \
+         relative for an error); otherwise the difference and where docs/NOTES.md isolates it.\n\n",
+    );
+    let header = [
+        "item",
+        "claim",
+        "field",
+        "paper",
+        "ours",
+        "tolerance",
+        "verdict",
+        "figures",
+        "why",
+    ]
+    .map(String::from);
+    let rows = claims.iter().map(|o| {
+        let links: Vec<String> = claim_figures(o, figures)
+            .map(|f| {
+                let link = f.file.to_string_lossy().replace('\\', "/");
+                format!(
+                    "[{}]({link})",
+                    f.file.file_stem().unwrap_or_default().to_string_lossy()
+                )
+            })
+            .collect();
+        vec![
+            o.claim.item.clone(),
+            o.claim.claim.clone(),
+            format!("{} {}", o.claim.field, o.claim.norm),
+            o.paper_text(),
+            o.ours_text(),
+            o.tolerance_text(),
+            o.verdict.as_str().to_string(),
+            links.join(", "),
+            o.claim.differs.clone().unwrap_or_default(),
         ]
     });
     table(md, &header, rows);

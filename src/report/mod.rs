@@ -5,6 +5,7 @@
 //! errors are fitted against h as a power law per field and norm.
 
 mod check;
+pub mod claims;
 pub mod figures;
 mod fit;
 mod format;
@@ -84,7 +85,8 @@ pub fn write_report(
         plot::render(&png, figure)?;
         fs::write(png.with_extension("csv"), tables::figure_csv(figure))?;
     }
-    let md = markdown::report_md(experiment, runs, rates, &tables, &figures, check);
+    let claims = claims::evaluate(experiment, rates, runs);
+    let md = markdown::report_md(experiment, runs, rates, &tables, &figures, &claims, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report {
         figures: figures.into_iter().map(|f| f.file).collect(),

@@ -68,6 +68,7 @@ pub(super) fn figures(
             scale: Scale::Linear,
             series,
             notes: Vec::new(),
+            drawn_by: None,
         });
     }
     figures

@@ -56,6 +56,7 @@ pub(super) fn figures(
                 scale: Scale::LogLog,
                 series,
                 notes,
+                drawn_by: None,
             })
         })
         .collect()

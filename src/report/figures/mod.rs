@@ -106,6 +106,8 @@ pub struct Figure {
     /// Lines under the legend: what the series do not show by themselves (the fits'
     /// pattern, runs that did not finish).
     pub notes: Vec<String>,
+    /// The `name` of the figures item that drew it (`plan` sets it).
+    pub drawn_by: Option<String>,
 }
 
 /// Every figure of the report: the experiment's own, or when it asks for none one convergence
@@ -195,6 +197,7 @@ fn name(experiment: &Experiment, spec: &FigureSpec, drawn: &mut [Figure], names:
             None => format!("{}_{}", slug(&experiment.name), figure.file.display()),
         };
         figure.file = names.file(&stem);
+        figure.drawn_by = spec.name.clone();
         if let Some(title) = &spec.title {
             figure.title = match several && !distinct.is_empty() {
                 true => format!("{title} ({distinct})"),

@@ -66,6 +66,7 @@ mod tests {
             scale: Scale::LogLog,
             series,
             notes: Vec::new(),
+            drawn_by: None,
         }
     }
 

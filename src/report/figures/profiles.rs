@@ -35,6 +35,7 @@ pub(super) fn reconstructions(runs: &[&RunSummary]) -> Vec<Figure> {
             scale: Scale::Linear,
             series,
             notes: Vec::new(),
+            drawn_by: None,
         }
     })
 }
@@ -106,6 +107,7 @@ pub(super) fn element_fits(runs: &[&RunSummary]) -> Vec<Figure> {
                 scale: Scale::Linear,
                 series,
                 notes: Vec::new(),
+                drawn_by: None,
             })
         })
         .filter(|figure| figure.series.iter().any(|s| !s.line.is_empty()))
@@ -149,6 +151,7 @@ pub(super) fn bases(runs: &[&RunSummary]) -> Vec<Figure> {
             scale: Scale::Linear,
             series,
             notes: Vec::new(),
+            drawn_by: None,
         })
     })
 }

@@ -63,6 +63,7 @@ pub(super) fn figures(selected: &[&RunSummary], spec: &FigureSpec) -> Vec<Figure
                 scale: Scale::Linear,
                 series,
                 notes: Vec::new(),
+                drawn_by: None,
             });
         }
     }

@@ -60,6 +60,7 @@ pub(super) fn limit_figures(
                 scale: Scale::Linear,
                 series,
                 notes: Vec::new(),
+                drawn_by: None,
             })
         })
         .collect()
@@ -151,6 +152,7 @@ pub(super) fn growth_figures(
                 scale: Scale::LogY,
                 series,
                 notes: Vec::new(),
+                drawn_by: None,
             })
         })
         .collect()
