@@ -1,7 +1,7 @@
 //! `figures` entries: which plots the report draws.
 
 use crate::benchmarks::BenchmarkKind;
-use crate::output::Measures;
+use crate::output::{map_fields, Measures};
 
 use super::error::ConfigError;
 use super::kinds::{Item, Kinds};
@@ -9,8 +9,9 @@ use super::measures::{error_field, norm};
 use super::select::axis_key;
 use super::space::ParamSpace;
 use super::stability;
+use super::values::choice;
 use super::yaml::{child_field, find, item_field, Entry, Node, NodeKind};
-use super::{FigureKind, FigureSpec};
+use super::{FieldMapSpec, FigureKind, FigureSpec};
 
 /// What a profile figure shows without `fields` (Wobbes Fig 4).
 const PROFILE_FIELD: &str = "stress";
@@ -26,8 +27,11 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("profile", FigureKind::Profile),
         ("shape_functions", FigureKind::ShapeFunctions),
         ("history", FigureKind::History),
+        ("field_map", FigureKind::FieldMap),
     ],
-    keys: &["kind", "fields", "norm", "by", "x", "sweep", "probe"],
+    keys: &[
+        "kind", "fields", "norm", "by", "x", "sweep", "probe", "field", "title",
+    ],
     takes,
     suits: draws_for,
 };
@@ -39,13 +43,14 @@ pub(crate) fn read(
     measures: Measures,
 ) -> Result<Vec<FigureSpec>, ConfigError> {
     KINDS.read_list(section, space, benchmark, |item| {
-        figure(item, space, measures)
+        figure(item, space, benchmark, measures)
     })
 }
 
 fn figure(
     item: Item<FigureKind>,
     space: &ParamSpace,
+    benchmark: BenchmarkKind,
     measures: Measures,
 ) -> Result<FigureSpec, ConfigError> {
     let Item {
@@ -83,6 +88,10 @@ fn figure(
         }
         (None, _) => None,
     };
+    let map = match kind {
+        FigureKind::FieldMap => Some(field_map(&entries, node, parent, benchmark)?),
+        _ => None,
+    };
     Ok(FigureSpec {
         kind: kind.clone(),
         fields,
@@ -91,10 +100,38 @@ fn figure(
         select,
         stability,
         probe,
+        map,
     })
 }
 
-/// The axis of `by`, or for a history or convergence figure also a list of axes.
+/// The required `field` of a field map, one its benchmark's runs can draw, and its optional
+/// `title`.
+fn field_map(
+    entries: &[Entry],
+    node: &Node,
+    parent: &str,
+    benchmark: BenchmarkKind,
+) -> Result<FieldMapSpec, ConfigError> {
+    let valid = map_fields(benchmark);
+    let field = match find(entries, "field") {
+        Some(e) => choice(e.value, &child_field(parent, "field"), "map field", valid)?,
+        None => {
+            return Err(ConfigError::at(
+                node.pos,
+                child_field(parent, "field"),
+                "a field_map figure needs 'field': the field it draws",
+            )
+            .with_valid(valid))
+        }
+    };
+    let title = match find(entries, "title") {
+        Some(e) => Some(e.value.as_text(&child_field(parent, "title"))?.to_string()),
+        None => None,
+    };
+    Ok(FieldMapSpec { field, title })
+}
+
+/// The axis of `by`, or for a history, convergence or field_map figure also a list of axes.
 fn by_axes(
     node: &Node,
     field: &str,
@@ -104,10 +141,13 @@ fn by_axes(
     let NodeKind::List(items) = &node.kind else {
         return Ok(vec![axis_key(node, field, space)?]);
     };
-    if !matches!(kind, FigureKind::History | FigureKind::Convergence) {
+    if !matches!(
+        kind,
+        FigureKind::History | FigureKind::Convergence | FigureKind::FieldMap
+    ) {
         return Err(node.expected(
             field,
-            "one matrix axis (a list applies to history and convergence figures)",
+            "one matrix axis (a list applies to history, convergence and field_map figures)",
         ));
     }
     if items.is_empty() {
@@ -130,6 +170,7 @@ fn takes(kind: &FigureKind) -> &'static [&'static str] {
         FigureKind::Profile => &["fields"],
         FigureKind::ShapeFunctions => &["by"],
         FigureKind::History => &["probe", "by"],
+        FigureKind::FieldMap => &["field", "title", "by"],
     }
 }
 
@@ -144,6 +185,7 @@ fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
         FigureKind::Stability | FigureKind::Growth | FigureKind::Profile | FigureKind::History => {
             benchmark == BenchmarkKind::Simulation
         }
+        FigureKind::FieldMap => !map_fields(benchmark).is_empty(),
     }
 }
 

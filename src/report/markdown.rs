@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use super::check::{describe, CheckFailure};
-use super::figures::Figure;
+use super::figures::{FieldMap, Figure};
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
 use super::pointwise::Table;
@@ -19,6 +19,7 @@ pub fn report_md(
     rates: &[RateRow],
     tables: &[Table],
     figures: &[Figure],
+    maps: &[FieldMap],
     check: Option<&[CheckFailure]>,
 ) -> String {
     let runs = ordered_runs(runs);
@@ -42,11 +43,12 @@ pub fn report_md(
             table(&mut md, &t.header, t.rows.iter().cloned());
         }
     }
-    if !figures.is_empty() {
+    if !figures.is_empty() || !maps.is_empty() {
         md.push_str("## Figures\n\n");
-        for figure in figures {
-            let link = figure.file.to_string_lossy().replace('\\', "/");
-            let _ = writeln!(md, "![{}]({link})\n", figure.title);
+        let captions = figures.iter().map(|f| (f.title.clone(), &f.file));
+        for (caption, file) in captions.chain(maps.iter().map(|m| (m.caption(), &m.file))) {
+            let link = file.to_string_lossy().replace('\\', "/");
+            let _ = writeln!(md, "![{caption}]({link})\n");
         }
     }
     if let Some(failures) = check {

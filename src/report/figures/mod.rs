@@ -2,6 +2,7 @@
 
 mod along_bar;
 mod convergence;
+mod field_map;
 mod history;
 mod profiles;
 mod shape_functions;
@@ -14,6 +15,8 @@ use super::group::{selects, slug};
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
 use crate::output::RunSummary;
+
+pub use field_map::{Cell, FieldMap, Panel};
 
 /// How the axes of a figure are scaled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -114,6 +117,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
         select: Selection::default(),
         stability: None,
         probe: None,
+        map: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -151,9 +155,33 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
             FigureKind::History => {
                 figures.extend(history::figures(experiment, &selected, spec, &mut names)?)
             }
+            // Not a plot of series: `plan_maps` plans these.
+            FigureKind::FieldMap => {}
         }
     }
     Ok(figures)
+}
+
+/// The field maps of the experiment's `field_map` entries, named after the `figures` that
+/// `plan` gave out. A map whose selected runs are all 1D is an error.
+pub fn plan_maps(
+    experiment: &Experiment,
+    runs: &[RunSummary],
+    figures: &[Figure],
+) -> Result<Vec<FieldMap>, String> {
+    let mut names = Names::after(figures);
+    let mut maps = Vec::new();
+    for spec in &experiment.figures {
+        if spec.kind != FigureKind::FieldMap {
+            continue;
+        }
+        let selected: Vec<&RunSummary> = runs
+            .iter()
+            .filter(|run| selects(&spec.select, &run.axes))
+            .collect();
+        maps.extend(field_map::figures(experiment, &selected, spec, &mut names)?);
+    }
+    Ok(maps)
 }
 
 /// File names already given out: two figures may land on the same stem, and later ones get
@@ -162,6 +190,12 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
 struct Names(BTreeSet<String>);
 
 impl Names {
+    /// With the names of `figures` given out already.
+    fn after(figures: &[Figure]) -> Names {
+        let stems = figures.iter().filter_map(|f| f.file.file_stem());
+        Names(stems.map(|s| s.to_string_lossy().into_owned()).collect())
+    }
+
     /// `figures/<experiment>_<what>.png`, made unique.
     fn file(&mut self, experiment: &Experiment, what: &str) -> PathBuf {
         let stem = format!("{}_{}", slug(&experiment.name), slug(what));
