@@ -1,14 +1,16 @@
 //! Gathers what a report needs from a results directory: the experiment (from its copy
 //! beside the runs) and the summary of every run file the experiment expands to, with the
-//! final fields along the bar and the errors against the reference run when it names one.
+//! final fields along the bar and the errors against the reference run when it names one, and
+//! the last particle state of each 2D run for field maps.
 
 mod compare;
 
 use std::path::Path;
 
+use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{self, Experiment};
 use crate::experiment::{FigureKind, TableKind};
-use crate::output::{read_probes, read_profile, read_summary, run_path, RunSummary};
+use crate::output::{read_final_state, read_probes, read_summary, run_path, Profile, RunSummary};
 use crate::runner::EXPERIMENT_COPY;
 
 pub struct Collected {
@@ -33,8 +35,16 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
         let path = run_path(dir, &spec.run_id);
         if path.exists() {
             let mut run = read_summary(&path)?;
+            let state = if wants_profiles(&experiment) || draws_particle_maps(&experiment) {
+                read_final_state(&path)?
+            } else {
+                None
+            };
             if wants_profiles(&experiment) {
-                run.profile = read_profile(&path)?;
+                run.profile = state.as_ref().map(Profile::from_state);
+            }
+            if draws_particle_maps(&experiment) {
+                run.final_state = state.filter(|s| s.dim == 2);
             }
             if reads_probes(&experiment) {
                 run.probes = read_probes(&path)?;
@@ -61,6 +71,15 @@ fn wants_profiles(experiment: &Experiment) -> bool {
             .figures
             .iter()
             .any(|f| f.kind == FigureKind::Profile)
+}
+
+/// Whether the report draws field maps of the particles of a simulation.
+fn draws_particle_maps(experiment: &Experiment) -> bool {
+    experiment.kind == BenchmarkKind::Simulation
+        && experiment
+            .figures
+            .iter()
+            .any(|f| f.kind == FigureKind::FieldMap)
 }
 
 /// Whether the report needs the `/probes` of every run: to draw their histories, for the

@@ -6,12 +6,12 @@ use std::path::Path;
 
 use mpmlab::benchmarks::BenchmarkKind;
 use mpmlab::experiment::{
-    Expectation, Experiment, FigureKind, FigureSpec, OutputSpec, ProbeWindow, Selection, TableKind,
-    TableSpec,
+    Expectation, Experiment, FieldMapSpec, FigureKind, FigureSpec, OutputSpec, ProbeWindow,
+    Selection, TableKind, TableSpec,
 };
-use mpmlab::output::{ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use mpmlab::output::{ParticleState, ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
-use mpmlab::report::{check, fit_rates, write_report, CheckFailure};
+use mpmlab::report::{check, figures, fit_rates, write_report, CheckFailure};
 
 /// Axis values written as in YAML: integers, floats or strings.
 fn params(pairs: &[(&str, &str)]) -> Params {
@@ -69,6 +69,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         max_momentum_error: f64::NAN,
         profile: None,
         probes: Vec::new(),
+        final_state: None,
     }
 }
 
@@ -378,6 +379,7 @@ fn figure_specs_split_by_the_remaining_axes() {
         name: None,
         title: None,
         paper: None,
+        map: None,
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let (dir, names) = figure_names(&exp);
@@ -408,6 +410,7 @@ fn named_figures_take_their_name_title_and_paper() {
         name: Some("fig4_7".into()),
         title: Some("MPM convergence".into()),
         paper: Some("Gong 2015, Fig 4.7".into()),
+        map: None,
     };
     let exp = experiment(vec![], vec![figure]);
     let (dir, names) = figure_names(&exp);
@@ -461,6 +464,7 @@ fn single_field_figures_are_named_by_their_field() {
         name: None,
         title: None,
         paper: None,
+        map: None,
     };
     let exp = experiment(vec![], vec![spec("velocity"), spec("stress")]);
     let (_dir, names) = figure_names(&exp);
@@ -547,6 +551,7 @@ fn history(probe: &str) -> FigureSpec {
         name: None,
         title: None,
         paper: None,
+        map: None,
     }
 }
 
@@ -643,4 +648,112 @@ fn conservation_tables_list_each_runs_mapping_errors() {
         "{md}"
     );
     assert!(md.contains("| 0.1 | usl | 8 | ok | NaN | NaN |"), "{md}");
+}
+
+/// `run` at 8 cells with a final particle state of two particles, whose stress yy is `yy`.
+fn mapped(g: &str, method: &str, yy: [f64; 2]) -> RunSummary {
+    let mut run = run(g, method, 8);
+    run.final_state = Some(ParticleState {
+        dim: 2,
+        time: 0.5,
+        x0: vec![0.25, 0.25, 0.75, 0.25],
+        x: vec![0.25, 0.2, 0.75, 0.2],
+        velocity: vec![0.0; 4],
+        stress: vec![0.0, 0.0, 0.0, yy[0], 0.0, 0.0, 0.0, yy[1]],
+        density: vec![1.0, 1.0],
+        volume: vec![0.25, 0.25],
+    });
+    run
+}
+
+fn field_map(field: &str) -> FigureSpec {
+    FigureSpec {
+        kind: FigureKind::FieldMap,
+        fields: Vec::new(),
+        norm: "l2".into(),
+        by: vec!["method".into()],
+        select: Selection::default(),
+        stability: None,
+        probe: None,
+        name: None,
+        title: None,
+        paper: Some("Paper, Fig 1".into()),
+        map: Some(FieldMapSpec {
+            field: field.into(),
+        }),
+    }
+}
+
+/// One map per group of the axes other than `by`, a panel per run, and one colour scale for
+/// every panel of the entry; the data file holds each cell as drawn.
+#[test]
+fn field_maps_are_planned_per_group_on_one_scale() {
+    let runs = vec![
+        mapped("0.1", "mpm", [-1.0, -2.0]),
+        mapped("0.1", "usl", [-1.5, -3.0]),
+        mapped("0.05", "mpm", [-0.5, -1.0]),
+    ];
+    let exp = experiment(vec![], vec![field_map("stress_yy")]);
+    let plots = figures::plan(&exp, &runs).unwrap();
+    assert!(plots.is_empty());
+    let maps = figures::plan_maps(&exp, &runs, &plots).unwrap();
+    let files: Vec<&Path> = maps.iter().map(|m| m.file.as_path()).collect();
+    assert_eq!(
+        files,
+        [
+            Path::new("figures/gong_conv_map_stress_yy_G_0.05_cells_8.png"),
+            Path::new("figures/gong_conv_map_stress_yy_G_0.1_cells_8.png"),
+        ]
+    );
+    let map = &maps[1];
+    assert_eq!(map.title, "Paper, Fig 1: stress yy at t = 0.5 s");
+    assert_eq!(map.scope, "G=0.1 cells=8");
+    assert_eq!(map.value_label, "stress yy (Pa)");
+    let labels: Vec<&str> = map.panels.iter().map(|p| p.label.as_str()).collect();
+    assert_eq!(labels, ["method=mpm", "method=usl"]);
+    let cell = map.panels[1].cells[1];
+    assert_eq!(
+        (cell.x, cell.y, cell.width, cell.value),
+        (0.75, 0.2, 0.5, -3.0)
+    );
+    // The scale spans every panel of both maps.
+    for map in &maps {
+        assert_eq!((map.scale.lo, map.scale.hi), (-3.0, -0.5));
+    }
+
+    let dir = tempfile::tempdir().unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    assert_eq!(report.figures, files);
+    for file in &report.figures {
+        assert!(dir.path().join(file).exists());
+    }
+    let csv = read(
+        dir.path(),
+        "figures/gong_conv_map_stress_yy_G_0.1_cells_8.csv",
+    );
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        lines[0],
+        "panel,role,x (m),y (m),width,height,stress yy (Pa)"
+    );
+    assert_eq!(lines[4], "method=usl,cell,0.75,0.2,0.5,0.5,-3.0");
+    assert_eq!(lines.len(), 5);
+    let md = read(dir.path(), "report.md");
+    assert!(
+        md.contains(
+            "![Paper, Fig 1: stress yy at t = 0.5 s: G=0.1 cells=8]\
+             (figures/gong_conv_map_stress_yy_G_0.1_cells_8.png)"
+        ),
+        "{md}"
+    );
+}
+
+/// A map of runs that are all 1D has nothing to draw, which the report says.
+#[test]
+fn field_maps_of_1d_runs_are_an_error() {
+    let mut one_d = run("0.1", "mpm", 8);
+    one_d.dim = 1;
+    let exp = experiment(vec![], vec![field_map("stress_yy")]);
+    let message = figures::plan_maps(&exp, &[one_d], &[]).unwrap_err();
+    assert!(message.contains("no selected run is 2D"), "{message}");
 }

@@ -3,7 +3,7 @@
 use std::cell::RefCell;
 
 use crate::benchmarks::BenchmarkKind;
-use crate::output::Measures;
+use crate::output::{map_fields, Measures};
 
 use super::error::ConfigError;
 use super::kinds::{Item, Kinds};
@@ -11,8 +11,9 @@ use super::measures::{error_field, norm};
 use super::select::axis_key;
 use super::space::ParamSpace;
 use super::stability;
+use super::values::choice;
 use super::yaml::{child_field, find, item_field, Entry, Node, NodeKind};
-use super::{FigureKind, FigureSpec};
+use super::{FieldMapSpec, FigureKind, FigureSpec};
 
 /// What a profile figure shows without `fields` (Wobbes Fig 4).
 const PROFILE_FIELD: &str = "stress";
@@ -28,8 +29,11 @@ const KINDS: Kinds<FigureKind> = Kinds {
         ("profile", FigureKind::Profile),
         ("shape_functions", FigureKind::ShapeFunctions),
         ("history", FigureKind::History),
+        ("field_map", FigureKind::FieldMap),
     ],
-    keys: &["kind", "fields", "norm", "by", "x", "sweep", "probe"],
+    keys: &[
+        "kind", "fields", "norm", "by", "x", "sweep", "probe", "field",
+    ],
     common: &["name", "title", "paper"],
     takes,
     suits: draws_for,
@@ -44,7 +48,7 @@ pub(crate) fn read(
     // Two figures of one name would overwrite each other's file.
     let names = RefCell::new(Vec::new());
     KINDS.read_list(section, space, benchmark, |item| {
-        figure(item, space, measures, &names)
+        figure(item, space, benchmark, measures, &names)
     })
 }
 
@@ -76,6 +80,7 @@ fn text(node: &Node, field: &str) -> Result<String, ConfigError> {
 fn figure(
     item: Item<FigureKind>,
     space: &ParamSpace,
+    benchmark: BenchmarkKind,
     measures: Measures,
     names: &RefCell<Vec<String>>,
 ) -> Result<FigureSpec, ConfigError> {
@@ -132,6 +137,10 @@ fn figure(
         names.push(name.clone());
     }
     let text_of = |key| Ok::<_, ConfigError>(given(key, text)?.map(|(t, _)| t));
+    let map = match kind {
+        FigureKind::FieldMap => Some(field_map(&entries, node, parent, benchmark)?),
+        _ => None,
+    };
     Ok(FigureSpec {
         name: name.map(|(name, _)| name),
         title: text_of("title")?,
@@ -143,10 +152,32 @@ fn figure(
         select,
         stability,
         probe,
+        map,
     })
 }
 
-/// The axis of `by`, or for a history or convergence figure also a list of axes.
+/// The required `field` of a field map, one its benchmark's runs can draw.
+fn field_map(
+    entries: &[Entry],
+    node: &Node,
+    parent: &str,
+    benchmark: BenchmarkKind,
+) -> Result<FieldMapSpec, ConfigError> {
+    let valid = map_fields(benchmark);
+    match find(entries, "field") {
+        Some(e) => Ok(FieldMapSpec {
+            field: choice(e.value, &child_field(parent, "field"), "map field", valid)?,
+        }),
+        None => Err(ConfigError::at(
+            node.pos,
+            child_field(parent, "field"),
+            "a field_map figure needs 'field': the field it draws",
+        )
+        .with_valid(valid)),
+    }
+}
+
+/// The axis of `by`, or for a history, convergence or field_map figure also a list of axes.
 fn by_axes(
     node: &Node,
     field: &str,
@@ -156,10 +187,13 @@ fn by_axes(
     let NodeKind::List(items) = &node.kind else {
         return Ok(vec![axis_key(node, field, space)?]);
     };
-    if !matches!(kind, FigureKind::History | FigureKind::Convergence) {
+    if !matches!(
+        kind,
+        FigureKind::History | FigureKind::Convergence | FigureKind::FieldMap
+    ) {
         return Err(node.expected(
             field,
-            "one matrix axis (a list applies to history and convergence figures)",
+            "one matrix axis (a list applies to history, convergence and field_map figures)",
         ));
     }
     if items.is_empty() {
@@ -182,6 +216,7 @@ fn takes(kind: &FigureKind) -> &'static [&'static str] {
         FigureKind::Profile => &["fields"],
         FigureKind::ShapeFunctions => &["by"],
         FigureKind::History => &["probe", "by"],
+        FigureKind::FieldMap => &["field", "by"],
     }
 }
 
@@ -196,6 +231,7 @@ fn draws_for(kind: &FigureKind, benchmark: BenchmarkKind) -> bool {
         FigureKind::Stability | FigureKind::Growth | FigureKind::Profile | FigureKind::History => {
             benchmark == BenchmarkKind::Simulation
         }
+        FigureKind::FieldMap => !map_fields(benchmark).is_empty(),
     }
 }
 

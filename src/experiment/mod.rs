@@ -233,6 +233,10 @@ pub enum FigureKind {
     /// A probe's value over time, one line per run (per value of `by` in one figure), with
     /// the benchmark's reference for it in grey (Molinos Figs 5-13).
     History,
+    /// A field over the plane of 2D runs, one coloured panel per run (per value of `by` in one
+    /// figure) on a colour scale the panels share: the particle state at the last sample, an
+    /// element-wise fit (Wobbes Fig 2), a shape function (Molinos Fig 3) or its derivative.
+    FieldMap,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -257,6 +261,15 @@ pub struct FigureSpec {
     pub stability: Option<StabilityAxes>,
     /// History figures only: the probe drawn (checked against the run files by the report).
     pub probe: Option<String>,
+    /// Field maps only.
+    pub map: Option<FieldMapSpec>,
+}
+
+/// What a field map draws.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldMapSpec {
+    /// One of the map fields of the benchmark's kind (`output::map_fields`).
+    pub field: String,
 }
 
 #[derive(Clone, Debug, PartialEq)]

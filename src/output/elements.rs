@@ -52,6 +52,13 @@ pub struct ElementRecord {
     pub curve_element: Vec<i64>,
     pub curve_exact: Vec<f64>,
     pub curve_reconstructed: Vec<f64>,
+    /// Nm x D, Nm, Nm, Nm: samples for maps over the plane, in 2D only (none in 1D, where the
+    /// curve is the whole domain): a lattice of cell centres in each element, x fastest,
+    /// element by element.
+    pub map_x: Vec<f64>,
+    pub map_element: Vec<i64>,
+    pub map_exact: Vec<f64>,
+    pub map_reconstructed: Vec<f64>,
     /// sqrt(sum_g error_g^2 / Ng), unweighted as in Wobbes sec 2.1.
     pub rms: f64,
     /// sum_g w_g u^h(x_g), the exact integral of u over the domain, and
@@ -93,13 +100,14 @@ pub(super) fn write(file: &File, r: &ElementRecord) -> hdf5::Result<()> {
         attr_f64(&group, name, value)?;
     }
     let d = r.dim;
-    let (ne, np, ng, nc) = (
+    let (ne, np, ng, nc, nm) = (
         r.mean.len(),
         r.data_u.len(),
         r.exact.len(),
         r.curve_exact.len(),
+        r.map_exact.len(),
     );
-    let f64_sets: [(&str, &Vec<f64>, Vec<usize>); 14] = [
+    let f64_sets: [(&str, &Vec<f64>, Vec<usize>); 17] = [
         ("lower", &r.lower, vec![ne, d]),
         ("upper", &r.upper, vec![ne, d]),
         ("mean", &r.mean, vec![ne]),
@@ -114,6 +122,9 @@ pub(super) fn write(file: &File, r: &ElementRecord) -> hdf5::Result<()> {
         ("curve_x", &r.curve_x, vec![nc, d]),
         ("curve_exact", &r.curve_exact, vec![nc]),
         ("curve_reconstructed", &r.curve_reconstructed, vec![nc]),
+        ("map_x", &r.map_x, vec![nm, d]),
+        ("map_exact", &r.map_exact, vec![nm]),
+        ("map_reconstructed", &r.map_reconstructed, vec![nm]),
     ];
     for (name, values, shape) in f64_sets {
         dataset(&group, name, values, &shape, UNIT)?;
@@ -123,6 +134,7 @@ pub(super) fn write(file: &File, r: &ElementRecord) -> hdf5::Result<()> {
         ("data_element", &r.data_element),
         ("gauss_element", &r.gauss_element),
         ("curve_element", &r.curve_element),
+        ("map_element", &r.map_element),
     ] {
         dataset(&group, name, values, &[values.len()], UNIT)?;
     }
@@ -162,6 +174,10 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ElementRecord>> {
         curve_element: int("curve_element")?,
         curve_exact: real("curve_exact")?,
         curve_reconstructed: real("curve_reconstructed")?,
+        map_x: real("map_x")?,
+        map_element: int("map_element")?,
+        map_exact: real("map_exact")?,
+        map_reconstructed: real("map_reconstructed")?,
         rms: read_f64(&group, "rms")?,
         integral: read_f64(&group, "integral")?,
         exact_integral: read_f64(&group, "exact_integral")?,
@@ -201,6 +217,10 @@ mod tests {
             curve_element: vec![0, 0],
             curve_exact: vec![0.0, 0.4],
             curve_reconstructed: vec![0.01, 0.41],
+            map_x: vec![0.5, 0.25, 1.5, 0.75, 0.5, 0.75],
+            map_element: vec![0, 1, 0],
+            map_exact: vec![0.2, 0.3, 0.4],
+            map_reconstructed: vec![0.21, f64::NAN, 0.39],
             rms: f64::NAN,
             integral: 0.3,
             exact_integral: 0.3,

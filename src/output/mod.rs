@@ -34,6 +34,34 @@ pub const SHAPE_FIELDS: [&str; 4] = ["partition", "moment", "gradient", "gradien
 /// Their norm: the largest over the evaluation points.
 pub const SHAPE_NORMS: [&str; 1] = ["max"];
 
+/// The fields a `field_map` figure draws over the plane of a 2D run, by kind of run. A
+/// simulation's are components of the particle state at the last sample (`displacement` is
+/// x - X); an element-wise reconstruction's are u^h and u - u^h at its map samples
+/// (`/elements/map_*`); a shape-function run's are N_a and the components of grad N_a of its
+/// centre node.
+pub const PARTICLE_MAP_FIELDS: [&str; 8] = [
+    "displacement_x",
+    "displacement_y",
+    "velocity_x",
+    "velocity_y",
+    "stress_xx",
+    "stress_yy",
+    "stress_xy",
+    "density",
+];
+pub const ELEMENT_MAP_FIELDS: [&str; 2] = ["reconstructed", "error"];
+pub const SHAPE_MAP_FIELDS: [&str; 3] = ["value", "gradient_x", "gradient_y"];
+
+/// The map fields of a kind of run; none for the nodal reconstructions, which are 1D.
+pub fn map_fields(kind: BenchmarkKind) -> &'static [&'static str] {
+    match kind {
+        BenchmarkKind::Simulation => &PARTICLE_MAP_FIELDS,
+        BenchmarkKind::Elementwise => &ELEMENT_MAP_FIELDS,
+        BenchmarkKind::ShapeFunctions => &SHAPE_MAP_FIELDS,
+        BenchmarkKind::Reconstruction | BenchmarkKind::OrthogonalBasis => &[],
+    }
+}
+
 /// The error fields a kind of run reports, each in each of the norms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Measures {
@@ -142,12 +170,43 @@ pub struct RunSummary {
     /// The `/probes` of a simulation run, when the report draws their histories (`collect`
     /// fills it); empty otherwise.
     pub probes: Vec<ProbeRecord>,
+    /// The last sample of a 2D simulation run, when the report draws field maps (`collect`
+    /// fills it).
+    pub final_state: Option<ParticleState>,
 }
 
 impl RunSummary {
     /// The run's probe `name`, when `collect` read the probes and the run records it.
     pub fn probe(&self, name: &str) -> Option<&ProbeRecord> {
         self.probes.iter().find(|p| p.name == name)
+    }
+}
+
+/// The last sample of a simulation run, one row per particle (per element for a reference
+/// solver), from `/particles`, `/history` and `/errors/volume`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleState {
+    pub dim: usize,
+    /// The sample's time: t_end, or where a diverged run stopped.
+    pub time: f64,
+    /// Np x D: reference and current positions, velocities.
+    pub x0: Vec<f64>,
+    pub x: Vec<f64>,
+    pub velocity: Vec<f64>,
+    /// Np x D x D, Cauchy stress.
+    pub stress: Vec<f64>,
+    pub density: Vec<f64>,
+    /// Current volumes (areas in 2D), the quadrature weights of the l2 norm.
+    pub volume: Vec<f64>,
+}
+
+impl ParticleState {
+    pub fn len(&self) -> usize {
+        self.density.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.density.is_empty()
     }
 }
 
@@ -166,6 +225,20 @@ pub struct Profile {
 }
 
 impl Profile {
+    /// The first component of every vector and tensor of a state, the whole state in 1D.
+    pub fn from_state(state: &ParticleState) -> Profile {
+        let d = state.dim;
+        let first = |values: &[f64], per: usize| values.iter().step_by(per).copied().collect();
+        Profile {
+            x0: first(&state.x0, d),
+            x: first(&state.x, d),
+            velocity: first(&state.velocity, d),
+            stress: first(&state.stress, d * d),
+            density: state.density.clone(),
+            volume: state.volume.clone(),
+        }
+    }
+
     /// The values of an error field (`displacement` is x - X).
     pub fn field(&self, field: &str) -> Vec<f64> {
         match field {
@@ -203,7 +276,7 @@ mod xdmf;
 pub use atomic::{describe_if_missing, run_path, write_atomically, write_run};
 pub use elements::ElementRecord;
 pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
-pub use reader::{read_probes, read_profile, read_summary};
+pub use reader::{read_final_state, read_probes, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,

@@ -6,8 +6,8 @@ use hdf5::Location;
 use ndarray::s;
 
 use super::{
-    elements, probes, reconstruction, shape_functions, ProbeRecord, Profile, RunStatus, RunSummary,
-    VelocityHistory, ERROR_FIELDS, NORMS,
+    elements, probes, reconstruction, shape_functions, ParticleState, ProbeRecord, RunStatus,
+    RunSummary, VelocityHistory, ERROR_FIELDS, NORMS,
 };
 use super::{
     ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS, SHAPE_FIELDS, SHAPE_NORMS,
@@ -73,6 +73,7 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
         max_momentum_error: conservation_attr(&file, "max_momentum_error"),
         profile: None,
         probes: Vec::new(),
+        final_state: None,
     })
 }
 
@@ -90,28 +91,40 @@ pub fn read_probes(path: &Path) -> Result<Vec<ProbeRecord>, String> {
     probes::read(&file).map_err(context)
 }
 
-/// The last sample of a 1D simulation run; `None` for a run without samples.
-pub fn read_profile(path: &Path) -> Result<Option<Profile>, String> {
+/// The last sample of a simulation run; `None` for a run without samples.
+pub fn read_final_state(path: &Path) -> Result<Option<ParticleState>, String> {
     let context = |e: hdf5::Error| format!("{}: {e}", path.display());
     let file = hdf5::File::open(path).map_err(context)?;
-    let time = file.dataset("history/time").map_err(context)?;
-    let Some(last) = time.size().checked_sub(1) else {
+    let times = file
+        .dataset("history/time")
+        .and_then(|t| t.read_raw::<f64>())
+        .map_err(context)?;
+    let Some(&time) = times.last() else {
         return Ok(None);
     };
+    let last = times.len() - 1;
+    // Row `last` of a dataset whose first axis is the sample, flattened.
     let read = |name: &str| -> hdf5::Result<Vec<f64>> {
         let ds = file.dataset(name)?;
         Ok(match ds.ndim() {
             2 => ds.read_slice_1d::<f64, _>(s![last, ..])?.to_vec(),
-            3 => ds.read_slice_1d::<f64, _>(s![last, .., 0])?.to_vec(),
-            _ => ds.read_slice_1d::<f64, _>(s![last, .., 0, 0])?.to_vec(),
+            3 => ds
+                .read_slice_2d::<f64, _>(s![last, .., ..])?
+                .iter()
+                .copied()
+                .collect(),
+            _ => ds
+                .read_slice::<f64, _, ndarray::Ix3>(s![last, .., .., ..])?
+                .iter()
+                .copied()
+                .collect(),
         })
     };
     let x0 = file.dataset("particles/X").map_err(context)?;
-    Ok(Some(Profile {
-        x0: x0
-            .read_slice_1d::<f64, _>(s![.., 0])
-            .map_err(context)?
-            .to_vec(),
+    Ok(Some(ParticleState {
+        dim: x0.shape().get(1).copied().unwrap_or(0),
+        time,
+        x0: x0.read_raw::<f64>().map_err(context)?,
         x: read("history/x").map_err(context)?,
         velocity: read("history/v").map_err(context)?,
         stress: read("history/stress").map_err(context)?,

@@ -144,7 +144,8 @@ fn same_value(a: &ParamValue, b: &ParamValue) -> bool {
     }
 }
 
-fn cmp_params(a: &Params, b: &Params) -> Ordering {
+/// Axis values in order: by key, then value (`cmp_value`).
+pub fn cmp_params(a: &Params, b: &Params) -> Ordering {
     a.iter()
         .zip(b)
         .map(|((ka, va), (kb, vb))| ka.cmp(kb).then_with(|| cmp_value(va, vb)))

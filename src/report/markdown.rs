@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use super::check::{describe, CheckFailure};
 use super::claims::{claim_figures, Outcome};
-use super::figures::Figure;
+use super::figures::{FieldMap, Figure};
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
 use super::pointwise::Table;
@@ -20,6 +20,7 @@ pub fn report_md(
     rates: &[RateRow],
     tables: &[Table],
     figures: &[Figure],
+    maps: &[FieldMap],
     claims: &[Outcome],
     check: Option<&[CheckFailure]>,
 ) -> String {
@@ -45,11 +46,12 @@ pub fn report_md(
             table(&mut md, &t.header, t.rows.iter().cloned());
         }
     }
-    if !figures.is_empty() {
+    if !figures.is_empty() || !maps.is_empty() {
         md.push_str("## Figures\n\n");
-        for figure in figures {
-            let link = figure.file.to_string_lossy().replace('\\', "/");
-            let _ = writeln!(md, "![{}]({link})\n", figure.title);
+        let captions = figures.iter().map(|f| (f.title.clone(), &f.file));
+        for (caption, file) in captions.chain(maps.iter().map(|m| (m.caption(), &m.file))) {
+            let link = file.to_string_lossy().replace('\\', "/");
+            let _ = writeln!(md, "![{caption}]({link})\n");
         }
     }
     if let Some(failures) = check {

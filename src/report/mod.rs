@@ -6,10 +6,12 @@
 
 mod check;
 pub mod claims;
+mod colour_map;
 pub mod figures;
 mod fit;
 mod format;
 mod group;
+mod map_plot;
 mod markdown;
 mod plot;
 mod pointwise;
@@ -59,8 +61,8 @@ pub struct Report {
     pub figures: Vec<PathBuf>,
 }
 
-/// Writes summary.csv, timings.csv, rates.csv, figures/*.png with their data figures/*.csv,
-/// and report.md into `dir`;
+/// Writes summary.csv, timings.csv, rates.csv, figures/*.png (plots, then field maps) with
+/// their data figures/*.csv, and report.md into `dir`;
 /// report.md gets a "Checks" section when `check` is given.
 pub fn write_report(
     dir: &Path,
@@ -70,10 +72,16 @@ pub fn write_report(
     check: Option<&[CheckFailure]>,
 ) -> io::Result<Report> {
     let figures = figures::plan(experiment, runs).map_err(io::Error::other)?;
+    let maps = figures::plan_maps(experiment, runs, &figures).map_err(io::Error::other)?;
     let tables = pointwise::tables(experiment, runs).map_err(io::Error::other)?;
     let figure_dir = dir.join("figures");
     fs::create_dir_all(&figure_dir)?;
-    remove_stale_figures(&figure_dir, &figures)?;
+    let files: Vec<PathBuf> = figures
+        .iter()
+        .map(|f| f.file.clone())
+        .chain(maps.iter().map(|m| m.file.clone()))
+        .collect();
+    remove_stale_figures(&figure_dir, &files)?;
     fs::write(
         dir.join("summary.csv"),
         tables::summary_csv(experiment, runs),
@@ -85,23 +93,28 @@ pub fn write_report(
         plot::render(&png, figure)?;
         fs::write(png.with_extension("csv"), tables::figure_csv(figure))?;
     }
+    for map in &maps {
+        let png = dir.join(&map.file);
+        map_plot::render(&png, map)?;
+        fs::write(png.with_extension("csv"), tables::map_csv(map))?;
+    }
     let claims = claims::evaluate(experiment, rates, runs);
-    let md = markdown::report_md(experiment, runs, rates, &tables, &figures, &claims, check);
+    let md = markdown::report_md(
+        experiment, runs, rates, &tables, &figures, &maps, &claims, check,
+    );
     fs::write(dir.join("report.md"), md)?;
-    Ok(Report {
-        figures: figures.into_iter().map(|f| f.file).collect(),
-    })
+    Ok(Report { figures: files })
 }
 
 /// PNGs and their data left by an earlier report whose figure this report no longer draws
 /// would otherwise be committed beside the current ones.
-fn remove_stale_figures(figure_dir: &Path, figures: &[figures::Figure]) -> io::Result<()> {
+fn remove_stale_figures(figure_dir: &Path, files: &[PathBuf]) -> io::Result<()> {
     for entry in fs::read_dir(figure_dir)? {
         let path = entry?.path();
         let ours = path.extension().is_some_and(|e| e == "png" || e == "csv");
-        let current = figures
+        let current = files
             .iter()
-            .any(|f| path.with_extension("png").ends_with(&f.file));
+            .any(|f| path.with_extension("png").ends_with(f));
         if ours && !current {
             fs::remove_file(&path)?;
         }

@@ -32,7 +32,7 @@ const LEGEND_COLUMN_CHARS: usize = 34;
 /// The legend's sample of a series, and where its label starts.
 const GLYPH_WIDTH: i32 = 30;
 const LABEL_OFFSET: i32 = 38;
-const FONT: &str = "sans-serif";
+pub(super) const FONT: &str = "sans-serif";
 /// Half the side of a square marker and the radius of a circle, in pixels.
 const MARKER_SIZE: i32 = 4;
 /// Dashes and their gaps, and the spacing and radius of dots, in pixels.
@@ -48,14 +48,14 @@ const NOTE_FONT: u32 = 14;
 const NOTE_ROW: u32 = 19;
 const NOTE_CHARS: usize = 95;
 
-/// The caption's font size: 22 px, smaller for a title that would not fit the width at 22 px
+/// The caption's font size: 22 px, smaller for a title that would not fit `width` at 22 px
 /// (DejaVu Sans Bold averages about 0.62 em per character), but never below 12 px.
-fn caption_size(title: &str) -> f64 {
-    let fitting = f64::from(WIDTH - 2 * MARGIN) / (0.62 * title.chars().count() as f64);
+pub(super) fn caption_size(title: &str, width: u32) -> f64 {
+    let fitting = f64::from(width) / (0.62 * title.chars().count() as f64);
     fitting.clamp(12.0, 22.0)
 }
 
-fn register_fonts() {
+pub(super) fn register_fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The embedded fonts are valid TrueType files, so registration cannot fail.
@@ -108,7 +108,7 @@ fn draw_axes(area: &Area, figure: &Figure, styles: &[Style]) -> DrawResult {
     builder
         .caption(
             &figure.title,
-            (FONT, caption_size(&figure.title))
+            (FONT, caption_size(&figure.title, WIDTH - 2 * MARGIN))
                 .into_font()
                 .style(FontStyle::Bold),
         )
@@ -420,7 +420,7 @@ fn padded_linear_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// A linear tick: three significant digits, and 0 for a tick that is zero up to rounding.
-fn linear_tick_label(v: f64, (lo, hi): (f64, f64)) -> String {
+pub(super) fn linear_tick_label(v: f64, (lo, hi): (f64, f64)) -> String {
     if v.abs() <= 1e-9 * (hi - lo) {
         "0".into()
     } else {

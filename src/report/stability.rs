@@ -291,6 +291,7 @@ mod tests {
             max_momentum_error: f64::NAN,
             profile: None,
             probes: Vec::new(),
+            final_state: None,
         }
     }
 

@@ -3,7 +3,7 @@
 
 use std::borrow::Cow;
 
-use super::figures::Figure;
+use super::figures::{FieldMap, Figure};
 use super::format::exact;
 use super::group::{self, ordered_runs};
 use super::RateRow;
@@ -99,6 +99,47 @@ pub fn figure_csv(figure: &Figure) -> String {
         rows.extend(points("line", &s.line));
         rows.extend(points("fit", &s.fit));
         rows
+    });
+    csv(&header, rows)
+}
+
+/// A field map's cells and markers exactly as drawn, one row per point: `panel` (its label),
+/// `role` (`cell` for a filled rectangle, `marker` for a point drawn over them, which has no
+/// size or value), the centre x and y, the rectangle's width and height (in the units of x
+/// and y) and the value its colour shows.
+pub fn map_csv(map: &FieldMap) -> String {
+    let header = [
+        "panel".to_string(),
+        "role".to_string(),
+        map.x_label.clone(),
+        map.y_label.clone(),
+        "width".to_string(),
+        "height".to_string(),
+        map.value_label.clone(),
+    ];
+    let rows = map.panels.iter().flat_map(|panel| {
+        let cells = panel.cells.iter().map(|c| {
+            vec![
+                panel.label.clone(),
+                "cell".to_string(),
+                exact(c.x),
+                exact(c.y),
+                exact(c.width),
+                exact(c.height),
+                exact(c.value),
+            ]
+        });
+        let markers = panel.markers.iter().map(|&(x, y)| {
+            let mut row = vec![
+                panel.label.clone(),
+                "marker".to_string(),
+                exact(x),
+                exact(y),
+            ];
+            row.extend([String::new(), String::new(), String::new()]);
+            row
+        });
+        cells.chain(markers).collect::<Vec<_>>()
     });
     csv(&header, rows)
 }

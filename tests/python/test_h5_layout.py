@@ -24,8 +24,8 @@ the limit the kernel approaches), and checks the stored maxima of the consistenc
 Element-wise runs (recon_tls) have an /elements group instead. For them it recomputes the
 elements, the data points of each, the Gauss points and weights (numpy's Gauss-Legendre rule),
 u there, each element's Taylor least-squares fit (numpy's SVD least squares, the element mean
-by numerical quadrature, the degree by the rank of the basis at the data), u^h, the RMS error
-and the relative integral error.
+by numerical quadrature, the degree by the rank of the basis at the data), u^h at the Gauss
+points and at the plot and map samples, the RMS error and the relative integral error.
 
 `make test` runs the reduced matrices in tests/matrices/ and points MPMLAB_RESULTS at them.
 Without the variable, or with no *.h5 file under it, the suite fails (it never passes empty).
@@ -928,7 +928,13 @@ ELEMENT_DATASETS = {
     "curve_element": ("curve", False, True),
     "curve_exact": ("curve", False, False),
     "curve_reconstructed": ("curve", False, False),
+    "map_x": ("map", True, False),
+    "map_element": ("map", False, True),
+    "map_exact": ("map", False, False),
+    "map_reconstructed": ("map", False, False),
 }
+# Map samples per axis across a 2D domain: MAP_SAMPLES // cells per element (at least one).
+MAP_SAMPLES = 60
 CONSERVATION = {"tls_fixed": "fixed", "tls_fitted": "fitted"}
 TLS_DEGREE = 2
 SURFACES = {
@@ -1032,6 +1038,8 @@ def test_elements_layout(run):
     if run.status == "ok":
         assert n["element"] == a["cells"] ** d
         assert n["gauss"] == n["element"] * g["gauss"] ** d
+        m = max(MAP_SAMPLES // a["cells"], 1) if d == 2 else 0
+        assert n["map"] == n["element"] * m**d, f"{n['map']} map samples"
 
 
 def test_elements_data_gauss_points_and_norms(run):
@@ -1116,18 +1124,33 @@ def test_element_fits_by_a_second_implementation(run):
                                    err_msg=f"coefficients of element {e}")
     assert g["degraded"] == np.count_nonzero(degrees < g["degree"])
 
-    # u^h at the Gauss points and the plot samples from the stored coefficients.
-    for where, element in (("gauss_x", "gauss_element"), ("curve_x", "curve_element")):
+    # u^h at the Gauss points and the plot and map samples from the stored coefficients.
+    for where, element, values in (("gauss_x", "gauss_element", "reconstructed"),
+                                   ("curve_x", "curve_element", "curve_reconstructed"),
+                                   ("map_x", "map_element", "map_reconstructed")):
         x, owners = run.ds(f"/elements/{where}"), run.ds(f"/elements/{element}")
+        if len(x) == 0:
+            continue
         c, half = (lower[owners] + upper[owners]) / 2, (upper[owners] - lower[owners]) / 2
         psi = taylor_basis((x - c) / half, g["degree"])
         expected = np.sum(psi * stored[owners], axis=1)
-        got = run.ds("/elements/reconstructed" if where == "gauss_x"
-                     else "/elements/curve_reconstructed")
+        got = run.ds(f"/elements/{values}")
         np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * max(1.0, np.max(np.abs(expected))),
                                    err_msg=f"u^h at {where}")
-    curve_x = run.ds("/elements/curve_x")
-    np.testing.assert_allclose(run.ds("/elements/curve_exact"), u(curve_x), rtol=0, atol=1e-14)
+    for where, values in (("curve_x", "curve_exact"), ("map_x", "map_exact")):
+        x = run.ds(f"/elements/{where}")
+        np.testing.assert_allclose(run.ds(f"/elements/{values}"), u(x), rtol=0, atol=1e-14)
+    if d == 2:
+        # The map: the cell centres of an m x m lattice in each element, x fastest.
+        m = max(MAP_SAMPLES // a["cells"], 1)
+        t = (np.arange(m) + 0.5) / m
+        tx, ty = np.meshgrid(t, t)
+        f = np.stack([tx.ravel(), ty.ravel()], axis=1)
+        expected = np.concatenate([lower[e] + f * (upper[e] - lower[e]) for e in range(len(lower))])
+        np.testing.assert_allclose(run.ds("/elements/map_x"), expected, rtol=0, atol=1e-13,
+                                   err_msg="map samples")
+        np.testing.assert_array_equal(run.ds("/elements/map_element"),
+                                      np.repeat(np.arange(len(lower)), m * m))
 
 
 # --------------------------------------------------------------------------------------------
@@ -1471,6 +1494,50 @@ def test_probe_references_by_a_second_implementation(run):
 CONVERGENCE_LABEL = re.compile(
     r"^(?P<field>[a-z]+)(?P<axes>(, [a-z_]+=[^,()]+)*)( \(rate [-0-9.na]+\))?$"
 )
+
+
+def test_field_map_data_matches_the_run_files():
+    """Every cell of the reduced TLS matrix's field map of u^h, as written beside the PNG, is a
+    map sample of the run its panel names, at its position with its u^h, and the markers are
+    that run's data points: the map's data is the run files' numbers, read back with h5py."""
+    root = _results_root()
+    figures = sorted((root / "ci_tls" / "figures").glob("ci_tls_map_reconstructed_*.csv")) \
+        if root is not None else []
+    if not figures:
+        pytest.skip("no reduced TLS report (make test writes it before this test)")
+    samples = {}
+    for path in sorted((root / "ci_tls" / "runs").glob("*.h5")):
+        with h5py.File(path, "r") as f:
+            if f.attrs["dim"] != 2 or f["elements"].attrs["gauss"] != 2:
+                continue
+            g = f["elements"]
+            method = f["matrix"].attrs["method"]
+            method = method.decode() if isinstance(method, bytes) else str(method)
+            samples[method] = (g["map_x"][()], g["map_reconstructed"][()], g["data_x"][()])
+    assert set(samples) == {"tls_fixed", "tls_fitted"}, sorted(samples)
+    checked = 0
+    for data in figures:
+        lines = data.read_text().splitlines()
+        header = lines[0].split(",")
+        assert header[:2] == ["panel", "role"] and header[4:6] == ["width", "height"], header
+        rows = {}
+        for row in lines[1:]:
+            panel, role, x, y, width, height, value = row.rsplit(",", 6)
+            method = re.match(r'^"?method=([a-z_]+)', panel)[1]
+            rows.setdefault((method, role), []).append((x, y, width, height, value))
+        for method, (map_x, uh, data_x) in samples.items():
+            cells = rows[(method, "cell")]
+            assert len(cells) == len(uh), f"{data.name}: {method} has {len(cells)} cells"
+            got = np.array([[float(c[0]), float(c[1]), float(c[4])] for c in cells])
+            np.testing.assert_array_equal(got[:, :2], map_x, err_msg=f"{data.name}: {method}")
+            np.testing.assert_array_equal(got[:, 2], uh, err_msg=f"{data.name}: {method}")
+            # The cells tile each element: as wide as the spacing of the samples.
+            width = float(cells[0][2])
+            np.testing.assert_allclose(width, np.min(np.diff(np.unique(map_x[:, 0]))), rtol=1e-12)
+            markers = np.array([[float(m[0]), float(m[1])] for m in rows[(method, "marker")]])
+            np.testing.assert_array_equal(markers, data_x, err_msg=f"{data.name}: {method}")
+            checked += len(cells)
+    assert checked >= 2 * 25, f"only {checked} cells checked"
 
 
 def test_convergence_figure_data_matches_the_run_files():

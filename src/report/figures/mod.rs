@@ -2,6 +2,7 @@
 
 mod along_bar;
 mod convergence;
+mod field_map;
 mod history;
 mod overlap;
 mod profiles;
@@ -15,6 +16,8 @@ use super::group::{label, selects, slug};
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
 use crate::output::RunSummary;
+
+pub use field_map::{Cell, FieldMap, Panel};
 
 /// How the axes of a figure are scaled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -131,6 +134,7 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
         name: None,
         title: None,
         paper: None,
+        map: None,
     }];
     let specs = if experiment.figures.is_empty() {
         &default[..]
@@ -157,6 +161,8 @@ pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>,
             FigureKind::Profile => along_bar::figures(experiment, runs, &selected, spec),
             FigureKind::ShapeFunctions => shape_functions::figures(&selected, spec),
             FigureKind::History => history::figures(experiment, &selected, spec)?,
+            // Not a plot of series: `plan_maps` plans these.
+            FigureKind::FieldMap => Vec::new(),
         };
         name(experiment, spec, &mut drawn, &mut names);
         drawn.iter_mut().for_each(overlap::mark_coincident);
@@ -210,12 +216,50 @@ fn name(experiment: &Experiment, spec: &FigureSpec, drawn: &mut [Figure], names:
     }
 }
 
+/// The field maps of the experiment's `field_map` entries, named after the `figures` that
+/// `plan` gave out. A map whose selected runs are all 1D is an error.
+pub fn plan_maps(
+    experiment: &Experiment,
+    runs: &[RunSummary],
+    figures: &[Figure],
+) -> Result<Vec<FieldMap>, String> {
+    let mut names = Names::after(figures);
+    let mut maps = Vec::new();
+    for spec in &experiment.figures {
+        if spec.kind != FigureKind::FieldMap {
+            continue;
+        }
+        let selected: Vec<&RunSummary> = runs
+            .iter()
+            .filter(|run| selects(&spec.select, &run.axes))
+            .collect();
+        maps.extend(field_map::figures(experiment, &selected, spec, &mut names)?);
+    }
+    Ok(maps)
+}
+
+/// The caption's opening: the item's `paper` and `title`, either alone, or the experiment's
+/// name when it gives neither.
+fn heading(experiment: &Experiment, spec: &FigureSpec) -> String {
+    match (&spec.paper, &spec.title) {
+        (Some(paper), Some(title)) => format!("{paper}: {title}"),
+        (Some(text), None) | (None, Some(text)) => text.clone(),
+        (None, None) => experiment.name.clone(),
+    }
+}
+
 /// File names already given out: two figures may land on the same stem, and later ones get
 /// a numeric suffix.
 #[derive(Default)]
 struct Names(BTreeSet<String>);
 
 impl Names {
+    /// With the names of `figures` given out already.
+    fn after(figures: &[Figure]) -> Names {
+        let stems = figures.iter().filter_map(|f| f.file.file_stem());
+        Names(stems.map(|s| s.to_string_lossy().into_owned()).collect())
+    }
+
     /// `figures/<stem>.png`, made unique.
     fn file(&mut self, stem: &str) -> PathBuf {
         let mut name = stem.to_string();

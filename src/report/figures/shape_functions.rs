@@ -1,6 +1,8 @@
 //! Shape-function figures (Molinos et al. Fig 3): N_a of the centre node and dN_a/dx along the
 //! line through it parallel to x (in 2D the section y = y_a), one curve per run, the hat in grey.
 
+use std::cmp::Ordering;
+
 use super::{default_stem, Figure, Scale, Series};
 use crate::experiment::FigureSpec;
 use crate::output::{RunSummary, ShapeFunctionRecord};
@@ -24,14 +26,7 @@ pub(super) fn figures(selected: &[&RunSummary], spec: &FigureSpec) -> Vec<Figure
             .filter_map(|run| Some((*run, run.shape_functions.as_ref()?)))
             .filter(|(_, r)| r.point_count() > 0)
             .collect();
-        // The LME curves by gamma, then the other bases by name.
-        runs.sort_by(|a, b| {
-            let key = |r: &ShapeFunctionRecord| (r.basis != "lme", r.gamma);
-            let (ka, kb) = (key(a.1), key(b.1));
-            ka.0.cmp(&kb.0)
-                .then(ka.1.total_cmp(&kb.1))
-                .then(a.1.basis.cmp(&b.1.basis))
-        });
+        runs.sort_by(|a, b| lme_first(a.1, b.1));
         if runs.is_empty() {
             continue;
         }
@@ -70,8 +65,17 @@ pub(super) fn figures(selected: &[&RunSummary], spec: &FigureSpec) -> Vec<Figure
     figures
 }
 
+/// The LME bases by gamma, then the other bases by name.
+pub(super) fn lme_first(a: &ShapeFunctionRecord, b: &ShapeFunctionRecord) -> Ordering {
+    let key = |r: &ShapeFunctionRecord| (r.basis != "lme", r.gamma);
+    let (ka, kb) = (key(a), key(b));
+    ka.0.cmp(&kb.0)
+        .then(ka.1.total_cmp(&kb.1))
+        .then(a.basis.cmp(&b.basis))
+}
+
 /// The basis, with gamma for LME.
-fn curve_label(r: &ShapeFunctionRecord) -> String {
+pub(super) fn curve_label(r: &ShapeFunctionRecord) -> String {
     if r.gamma.is_finite() {
         format!("{} gamma = {}", r.basis, general(r.gamma, 3))
     } else {

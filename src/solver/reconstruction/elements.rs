@@ -11,6 +11,9 @@ use crate::shape::lattice_coords;
 
 /// Plot samples per element along x.
 const CURVE_SAMPLES: usize = 101;
+/// Map samples per axis across a 2D domain, about: each element gets MAP_SAMPLES / cells per
+/// axis (at least one), so the map stays the same size however fine the grid.
+const MAP_SAMPLES: usize = 60;
 
 /// Fits every element of `data` at `degree` and measures the errors.
 pub(super) fn reconstruct<const D: usize, F: ExactField<D>>(
@@ -26,6 +29,7 @@ pub(super) fn reconstruct<const D: usize, F: ExactField<D>>(
     // The row of elements the plot samples run through, and the height they run at (2D).
     let curve_row = cells / 2;
     let curve_y = data.domain.lower[D - 1] + (curve_row as f64 + 0.5) * h;
+    let map_samples = (MAP_SAMPLES / cells).max(1);
     let mut out = ElementRecord {
         formula: u.formula().to_string(),
         conservation: conservation.to_string(),
@@ -96,6 +100,19 @@ pub(super) fn reconstruct<const D: usize, F: ExactField<D>>(
                 out.curve_element.push(e as i64);
                 out.curve_exact.push(u.value(&x));
                 out.curve_reconstructed.push(eval(&x));
+            }
+        }
+        if D == 2 {
+            for s in 0..map_samples.pow(2) {
+                let at = lattice_coords(s, &[map_samples; D]);
+                let x = SVector::<f64, D>::from_fn(|k, _| {
+                    let t = (at[k] as f64 + 0.5) / map_samples as f64;
+                    cell.lower()[k] + t * (cell.upper()[k] - cell.lower()[k])
+                });
+                out.map_x.extend(x.iter());
+                out.map_element.push(e as i64);
+                out.map_exact.push(u.value(&x));
+                out.map_reconstructed.push(eval(&x));
             }
         }
     }
