@@ -1,12 +1,16 @@
 # mpmlab: install, build, test and reproduce every result.
 #
 #   make            (= make all) install what is missing, build, run every experiments/*.yaml
-#                   into results/<name>/ and write its report
+#                   into results/<name>/, write its report, and the reproduction index
+#                   results/README.md
 #   make test       lint, unit tests, reduced matrices in tests/matrices/, `mpmlab report
-#                   --check` on each reduced matrix, HDF5 layout and XDMF tests, then test-slurm
+#                   --check` on each reduced matrix, HDF5 layout and XDMF tests, test-slurm,
+#                   then reproduce
 #   make test-slurm the reduced matrices as a Slurm array on a one-node cluster started for
 #                   the test (installs slurm and munge when missing), compared bit for bit
 #                   with a single-machine run
+#   make reproduce  every experiment from scratch into target/reproduce, compared byte for
+#                   byte with the committed results/ (part of make test)
 #   make bench      particle-steps per second per method and dimension
 #   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
 #   make clean-results   delete generated HDF5 run files and their XDMF descriptions
@@ -44,6 +48,7 @@ VENV_PY := $(VENV)/bin/python
 PY_REQUIREMENTS := tests/python/requirements.txt
 VENV_STAMP := $(VENV)/.mpmlab-requirements
 TEST_OUT := target/test-matrices
+REPRO_OUT := target/reproduce
 
 EXPERIMENTS = $(sort $(wildcard experiments/*.yaml))
 MATRICES = $(sort $(wildcard tests/matrices/*.yaml))
@@ -52,7 +57,7 @@ RUN_FLAGS = $(if $(JOBS),--jobs $(JOBS)) $(if $(FORCE),--force)
 # die, step, apt_install, check_stems
 SH_LIB := source scripts/lib.sh
 
-.PHONY: all deps deps-system deps-python build lint test test-slurm bench clean-results
+.PHONY: all deps deps-system deps-python build lint test test-slurm reproduce bench clean-results
 
 all: deps build
 	@$(SH_LIB)
@@ -66,7 +71,9 @@ all: deps build
 	  step "$(BIN) report $(RESULTS)/$$name"
 	  $(BIN) report "$(RESULTS)/$$name"
 	done
-	echo "reports: $(RESULTS)/*/report.md"
+	step "$(BIN) index $(RESULTS)"
+	$(BIN) index "$(RESULTS)"
+	echo "reports: $(RESULTS)/*/report.md, index: $(RESULTS)/README.md"
 
 deps: deps-system deps-python
 
@@ -136,6 +143,18 @@ test: deps lint build
 	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
 	step "scripts/test-slurm.sh (make test-slurm)"
 	scripts/test-slurm.sh "$(BIN)" "$(VENV_PY)"
+	$(MAKE) --no-print-directory reproduce
+
+# Every experiment from scratch into $(REPRO_OUT), compared byte for byte with the committed
+# results/ (all but the run files and the wall times, which are not committed).
+reproduce: deps build
+	@$(SH_LIB)
+	rm -rf "$(REPRO_OUT)"
+	$(MAKE) --no-print-directory all RESULTS="$(REPRO_OUT)" FORCE=
+	step "diff -r results $(REPRO_OUT)"
+	diff -r -q -x runs -x timings.csv results "$(REPRO_OUT)" \
+	  || die "the committed results/ differ from a fresh make all (listed above)"
+	echo "committed results reproduce byte for byte"
 
 # A one-node Slurm cluster in a temporary directory, stopped again by the script; see the
 # comment at the top of scripts/test-slurm.sh.

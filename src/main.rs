@@ -3,9 +3,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use mpmlab::collect::collect;
+use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
-use mpmlab::runner::{results_dir, run_experiment, RunOptions};
+use mpmlab::output::write_atomically;
+use mpmlab::runner::{results_dir, run_experiment, RunOptions, EXPERIMENT_COPY};
 use mpmlab::shard::{Plan, Shard};
 use mpmlab::slurm;
 use mpmlab::{
@@ -94,6 +95,9 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// Write <dir>/README.md, the reproduction index: every paper claim of the results
+    /// directories under <dir> beside ours, with verdicts and the figures of each paper item.
+    Index { dir: PathBuf },
     /// List the method presets and what they are composed of, and the reconstruction methods.
     ListMethods,
     /// List the benchmarks and their parameters.
@@ -139,6 +143,7 @@ fn main() -> ExitCode {
             )
         }),
         Command::Report { dir, check } => report_dir(&dir, check),
+        Command::Index { dir } => index(&dir),
         Command::ListMethods => {
             list_methods();
             Ok(())
@@ -272,6 +277,43 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
         ));
     }
     eprintln!("all expectations met");
+    Ok(())
+}
+
+/// The index over every results directory under `root` (those with an experiment copy).
+fn index(root: &Path) -> Result<(), String> {
+    let read = std::fs::read_dir(root).map_err(|e| format!("{}: {e}", root.display()))?;
+    let mut dirs: Vec<String> = read
+        .filter_map(|entry| entry.ok())
+        .filter(|entry| entry.path().join(EXPERIMENT_COPY).exists())
+        .map(|entry| entry.file_name().to_string_lossy().into_owned())
+        .collect();
+    dirs.sort();
+    let collected: Vec<Collected> = dirs
+        .iter()
+        .map(|dir| collect(&root.join(dir)))
+        .collect::<Result<_, _>>()?;
+    let rates: Vec<Vec<report::RateRow>> = collected
+        .iter()
+        .map(|c| report::fit_rates(&c.experiment, &c.runs))
+        .collect();
+    let mut indexed = Vec::new();
+    for ((dir, c), rates) in dirs.iter().zip(&collected).zip(&rates) {
+        let figures = report::figures::plan(&c.experiment, &c.runs)?;
+        let maps = report::figures::plan_maps(&c.experiment, &c.runs, &figures)?;
+        indexed.push(report::index::Indexed {
+            dir,
+            experiment: &c.experiment,
+            claims: report::claims::evaluate(&c.experiment, rates, &c.runs),
+            figures,
+            maps,
+        });
+    }
+    let path = root.join("README.md");
+    let md = report::index::index_md(&indexed);
+    write_atomically(&path, |tmp| std::fs::write(tmp, &md))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    eprintln!("index written to {}", path.display());
     Ok(())
 }
 

@@ -6,12 +6,13 @@ use std::path::Path;
 
 use mpmlab::benchmarks::BenchmarkKind;
 use mpmlab::experiment::{
-    Expectation, Experiment, FieldMapSpec, FigureKind, FigureSpec, OutputSpec, ProbeWindow,
-    Selection, TableKind, TableSpec,
+    ClaimedValue, Expectation, Experiment, FieldMapSpec, FigureKind, FigureSpec, OutputSpec,
+    PaperClaim, ProbeWindow, Selection, TableKind, TableSpec,
 };
 use mpmlab::output::{ParticleState, ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
 use mpmlab::params::{ParamValue, Params};
-use mpmlab::report::{check, figures, fit_rates, write_report, CheckFailure};
+use mpmlab::report::claims::{self, Verdict};
+use mpmlab::report::{check, figures, fit_rates, index, write_report, CheckFailure};
 
 /// Axis values written as in YAML: integers, floats or strings.
 fn params(pairs: &[(&str, &str)]) -> Params {
@@ -756,4 +757,68 @@ fn field_maps_of_1d_runs_are_an_error() {
     let exp = experiment(vec![], vec![field_map("stress_yy")]);
     let message = figures::plan_maps(&exp, &[one_d], &[]).unwrap_err();
     assert!(message.contains("no selected run is 2D"), "{message}");
+}
+
+fn claim(line: usize, rate: f64, differs: Option<&str>) -> PaperClaim {
+    PaperClaim {
+        item: "Gong 2015, Fig 4.7".into(),
+        claim: "second order".into(),
+        figure: None,
+        select: Selection::from(&params(&[("G", "0.1"), ("method", "mpm")])),
+        field: "displacement".into(),
+        norm: "l2".into(),
+        value: ClaimedValue::Rate(rate),
+        tolerance: 0.1,
+        differs: differs.map(String::from),
+        line,
+    }
+}
+
+/// A claim within its tolerance is reproduced; outside it needs a note, and a note on one
+/// that is within is stale: `--check` fails on both. report.md and the index show them all.
+#[test]
+fn paper_claims_get_verdicts_and_fail_the_check_when_unexplained() {
+    let mut exp = experiment(vec![], vec![]);
+    exp.paper_claims = vec![
+        claim(1, 2.0, None),
+        claim(2, 3.0, None),
+        claim(3, 3.0, Some("docs/NOTES.md, item 9")),
+        claim(4, 2.0, Some("docs/NOTES.md, item 9")),
+    ];
+    let runs = runs();
+    let rates = fit_rates(&exp, &runs);
+    let outcomes = claims::evaluate(&exp, &rates, &runs);
+    let verdicts: Vec<Verdict> = outcomes.iter().map(|o| o.verdict).collect();
+    assert_eq!(
+        verdicts,
+        [
+            Verdict::Reproduced,
+            Verdict::Unexplained,
+            Verdict::Differs,
+            Verdict::Stale
+        ]
+    );
+    assert_eq!(outcomes[0].ours_text(), "2");
+    let failed: Vec<usize> = check(&exp, &rates, &runs).iter().map(|f| f.line).collect();
+    assert_eq!(failed, [2, 4]);
+    let dir = tempfile::tempdir().unwrap();
+    write_report(dir.path(), &exp, &runs, &rates, None).unwrap();
+    let md = read(dir.path(), "report.md");
+    assert!(
+        md.contains("| Gong 2015, Fig 4.7 | second order | displacement l2 | rate 3 | 2 | ± 0.1 | differs |  | docs/NOTES.md, item 9 |"),
+        "{md}"
+    );
+    let indexed = index::Indexed {
+        dir: "gong_conv",
+        experiment: &exp,
+        claims: outcomes,
+        figures: Vec::new(),
+        maps: Vec::new(),
+    };
+    let front = index::index_md(&[indexed]);
+    assert!(
+        front.contains("| reproduced | 1 |\n| differs | 1 |\n| differs, unexplained | 1 |"),
+        "{front}"
+    );
+    assert!(front.contains("## Gong 2015: claims"), "{front}");
 }

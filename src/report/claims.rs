@@ -66,6 +66,21 @@ impl Outcome<'_> {
         values.join("; ")
     }
 
+    /// The row of a claims table (`COLUMNS`), with `figures` as its links.
+    pub fn cells(&self, figures: String) -> Vec<String> {
+        vec![
+            self.claim.item.clone(),
+            self.claim.claim.clone(),
+            format!("{} {}", self.claim.field, self.claim.norm),
+            self.paper_text(),
+            self.ours_text(),
+            self.tolerance_text(),
+            self.verdict.as_str().to_string(),
+            figures,
+            self.claim.differs.clone().unwrap_or_default(),
+        ]
+    }
+
     pub fn tolerance_text(&self) -> String {
         match self.claim.value {
             ClaimedValue::Rate(_) => format!("± {}", general(self.claim.tolerance, 3)),
@@ -73,6 +88,19 @@ impl Outcome<'_> {
         }
     }
 }
+
+/// The header of a claims table.
+pub const COLUMNS: [&str; 9] = [
+    "item",
+    "claim",
+    "field",
+    "paper",
+    "ours",
+    "tolerance",
+    "verdict",
+    "figures",
+    "why it differs",
+];
 
 pub fn evaluate<'a>(
     experiment: &'a Experiment,
@@ -126,15 +154,23 @@ fn measured(claim: &PaperClaim, rates: &[RateRow], runs: &[RunSummary]) -> Vec<(
     }
 }
 
-/// The figures the claim's `figure` item drew.
+/// The figures the claim's `figure` item drew of the runs the claim selects: those whose
+/// variant values its selectors allow.
 pub fn claim_figures<'a>(
     outcome: &'a Outcome,
     figures: &'a [Figure],
 ) -> impl Iterator<Item = &'a Figure> + 'a {
-    let name = outcome.claim.figure.as_deref();
-    figures
-        .iter()
-        .filter(move |f| name.is_some() && f.drawn_by.as_deref() == name)
+    let claim = outcome.claim;
+    let name = claim.figure.as_deref();
+    let allows = move |(axis, value): &(String, String)| {
+        claim
+            .select
+            .get(axis)
+            .is_none_or(|allowed| allowed.values().iter().any(|v| v.to_string() == *value))
+    };
+    figures.iter().filter(move |f| {
+        name.is_some() && f.drawn_by.as_deref() == name && f.variant.iter().all(allows)
+    })
 }
 
 /// A claim `--check` cannot let pass: unexplained, stale or unmeasured.

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use super::check::{describe, CheckFailure};
-use super::claims::{claim_figures, Outcome};
+use super::claims::{claim_figures, Outcome, COLUMNS};
 use super::figures::{FieldMap, Figure};
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
@@ -14,16 +14,28 @@ use crate::benchmarks::BenchmarkKind;
 use crate::experiment::Experiment;
 use crate::output::{RunStatus, RunSummary, REFERENCE_NORM, SHAPE_FIELDS};
 
+/// What the report computed besides the rates: its tables, figures, field maps and the
+/// papers' claims against ours.
+pub struct Contents<'a> {
+    pub tables: &'a [Table],
+    pub figures: &'a [Figure],
+    pub maps: &'a [FieldMap],
+    pub claims: &'a [Outcome<'a>],
+}
+
 pub fn report_md(
     experiment: &Experiment,
     runs: &[RunSummary],
     rates: &[RateRow],
-    tables: &[Table],
-    figures: &[Figure],
-    maps: &[FieldMap],
-    claims: &[Outcome],
+    contents: &Contents,
     check: Option<&[CheckFailure]>,
 ) -> String {
+    let Contents {
+        tables,
+        figures,
+        maps,
+        claims,
+    } = *contents;
     let runs = ordered_runs(runs);
     let mut md = format!("# {}\n\n", experiment.name);
     if !experiment.description.is_empty() {
@@ -254,41 +266,17 @@ fn claims_table(md: &mut String, claims: &[Outcome], figures: &[Figure]) {
          reproduced when every measured value is within the tolerance (absolute for a rate, \
          relative for an error); otherwise the difference and where docs/NOTES.md isolates it.\n\n",
     );
-    let header = [
-        "item",
-        "claim",
-        "field",
-        "paper",
-        "ours",
-        "tolerance",
-        "verdict",
-        "figures",
-        "why",
-    ]
-    .map(String::from);
     let rows = claims.iter().map(|o| {
         let links: Vec<String> = claim_figures(o, figures)
             .map(|f| {
                 let link = f.file.to_string_lossy().replace('\\', "/");
-                format!(
-                    "[{}]({link})",
-                    f.file.file_stem().unwrap_or_default().to_string_lossy()
-                )
+                let stem = f.file.file_stem().unwrap_or_default().to_string_lossy();
+                format!("[{stem}]({link})")
             })
             .collect();
-        vec![
-            o.claim.item.clone(),
-            o.claim.claim.clone(),
-            format!("{} {}", o.claim.field, o.claim.norm),
-            o.paper_text(),
-            o.ours_text(),
-            o.tolerance_text(),
-            o.verdict.as_str().to_string(),
-            links.join(", "),
-            o.claim.differs.clone().unwrap_or_default(),
-        ]
+        o.cells(links.join(", "))
     });
-    table(md, &header, rows);
+    table(md, &COLUMNS.map(String::from), rows);
 }
 
 fn checks(md: &mut String, experiment: &Experiment, failures: &[CheckFailure]) {
@@ -308,7 +296,7 @@ fn checks(md: &mut String, experiment: &Experiment, failures: &[CheckFailure]) {
     md.push('\n');
 }
 
-fn table(md: &mut String, header: &[String], rows: impl Iterator<Item = Vec<String>>) {
+pub(super) fn table(md: &mut String, header: &[String], rows: impl Iterator<Item = Vec<String>>) {
     let line = |cells: &[String]| {
         let cells: Vec<String> = cells.iter().map(|c| cell(c)).collect();
         format!("| {} |\n", cells.join(" | "))

@@ -11,6 +11,7 @@ pub mod figures;
 mod fit;
 mod format;
 mod group;
+pub mod index;
 mod map_plot;
 mod markdown;
 mod plot;
@@ -99,9 +100,13 @@ pub fn write_report(
         fs::write(png.with_extension("csv"), tables::map_csv(map))?;
     }
     let claims = claims::evaluate(experiment, rates, runs);
-    let md = markdown::report_md(
-        experiment, runs, rates, &tables, &figures, &maps, &claims, check,
-    );
+    let contents = markdown::Contents {
+        tables: &tables,
+        figures: &figures,
+        maps: &maps,
+        claims: &claims,
+    };
+    let md = markdown::report_md(experiment, runs, rates, &contents, check);
     fs::write(dir.join("report.md"), md)?;
     Ok(Report { figures: files })
 }

@@ -35,6 +35,8 @@ pub struct FieldMap {
     pub panels: Vec<Panel>,
     /// What the points drawn over the cells are, for the legend; empty when there are none.
     pub marker_label: String,
+    /// The `name` of the figures item that drew it.
+    pub drawn_by: Option<String>,
 }
 
 impl FieldMap {
@@ -159,6 +161,7 @@ pub(super) fn figures(
                 ),
             }),
             title: format!("{}: {what}", heading(experiment, spec)),
+            drawn_by: spec.name.clone(),
             scope,
             x_label: labels.x,
             y_label: labels.y,
