@@ -604,12 +604,53 @@ fn defaults_fill_what_the_file_leaves_out() {
     assert_eq!(run.run_id.matches("mpm").count(), 1, "{}", run.run_id);
     assert_eq!(
         exp.figures[0].fields,
-        ["displacement", "velocity", "stress", "density"]
+        [
+            "displacement",
+            "velocity",
+            "stress",
+            "density",
+            "grid_velocity"
+        ]
     );
     assert_eq!(
         (exp.figures[0].norm.as_str(), exp.figures[0].by.is_empty()),
         ("l2", true)
     );
+}
+
+/// Only a benchmark that knows the exact velocity at the nodes has the field `grid_velocity`;
+/// elsewhere it is an unknown field, with the particle fields listed.
+#[test]
+fn grid_velocity_is_a_field_of_the_manufactured_solutions_only() {
+    let text = |benchmark: &str, params: &str| {
+        format!(
+            "name: x\nbenchmark: {benchmark}\nparams: {{method: mpm, cells: 4, {params}}}\n\
+             expect:\n  - {{field: grid_velocity, rate_min: 1.0}}\n"
+        )
+    };
+    for (benchmark, params) in [
+        ("mms1d_gong", "G: 0.1, ppc: 2"),
+        ("mms2d_gong", "G: 0.1, ppc: 2"),
+        ("mms1d_tran", "ppc: 3"),
+    ] {
+        let exp = parse(&text(benchmark, params)).unwrap();
+        assert_eq!(exp.expect[0].field, "grid_velocity", "{benchmark}");
+    }
+    let e = error(&text("vibrating_bar", "ppc: 2"));
+    check(
+        &e,
+        5,
+        13,
+        "expect[0].field",
+        "unknown field",
+        &["displacement", "velocity", "stress", "density"],
+    );
+    assert!(!e.valid.iter().any(|v| v == "grid_velocity"), "{e}");
+    let defaults = parse(
+        "name: x\nbenchmark: dyka_bar\nparams: {method: mpm}\nfigures: [{kind: convergence}]\n",
+    )
+    .unwrap();
+    assert_eq!(defaults.figures[0].fields.len(), 4);
 }
 
 fn ids(text: &str) -> Vec<String> {

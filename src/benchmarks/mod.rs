@@ -149,6 +149,19 @@ pub fn kind(info: &BenchmarkInfo) -> BenchmarkKind {
         .unwrap_or(BenchmarkKind::Simulation)
 }
 
+/// The benchmarks whose `Problem::material_point` inverts the exact motion, so that their
+/// runs also measure the grid velocity against the exact one: the manufactured solutions.
+const EXACT_ON_GRID: [&str; 3] = [
+    mms_gong::INFO_1D.name,
+    mms_gong::INFO_2D.name,
+    mms_tran::INFO.name,
+];
+
+/// Whether runs of the benchmark know the exact velocity at the grid's nodes.
+pub fn exact_on_grid(info: &BenchmarkInfo) -> bool {
+    EXACT_ON_GRID.contains(&info.name)
+}
+
 pub fn catalog() -> &'static [BenchmarkInfo] {
     CATALOG
 }
@@ -295,6 +308,13 @@ pub trait Problem<const D: usize>: Send + Sync {
     /// Prepare `body_force` for these reference positions (called once before stepping).
     fn attach_particles(&mut self, x0: &[SVector<f64, D>]);
     fn exact(&self, x0: &SVector<f64, D>, t: f64) -> Option<ExactState<D>>;
+    /// The reference position X of the material point at `x` at time `t`: the inverse of the
+    /// exact motion, through which the exact velocity is known at a grid node. `None` where
+    /// the benchmark does not invert its motion (only the manufactured solutions do, as
+    /// `exact_on_grid` lists) or `x` is outside the body.
+    fn material_point(&self, _x: &SVector<f64, D>, _t: f64) -> Option<SVector<f64, D>> {
+        None
+    }
     /// Where the particles are seeded inside each cell.
     fn placement(&self) -> Placement {
         Placement::SubCellCentres
@@ -330,5 +350,55 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
             "benchmark",
             format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A benchmark's catalogue defaults with its required parameters filled in.
+    fn runnable_params(info: &BenchmarkInfo) -> Params {
+        let mut params = default_params(info.params);
+        for spec in info.params {
+            if spec.default == ParamDefault::Required {
+                let value = match spec.kind {
+                    ParamKind::PositiveInt => ParamValue::Int(4),
+                    _ => ParamValue::Float(0.01),
+                };
+                params.insert(spec.key.to_string(), value);
+            }
+        }
+        params
+    }
+
+    /// `exact_on_grid` lists exactly the simulation benchmarks whose problem inverts its
+    /// motion at a point of the body (its lower corner and a point inside).
+    #[test]
+    fn exact_on_grid_lists_the_problems_that_invert_their_motion() {
+        let mut listed = 0;
+        for info in catalog()
+            .iter()
+            .filter(|i| kind(i) == BenchmarkKind::Simulation)
+        {
+            let params = runnable_params(info);
+            let problem =
+                build(info.name, &params).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+            let inverts = match problem {
+                AnyProblem::D1(p) => {
+                    let (lo, hi) = p.body();
+                    p.material_point(&lo, 1e-3).is_some()
+                        && p.material_point(&(0.3 * lo + 0.7 * hi), 1e-3).is_some()
+                }
+                AnyProblem::D2(p) => {
+                    let (lo, hi) = p.body();
+                    p.material_point(&lo, 1e-3).is_some()
+                        && p.material_point(&(0.3 * lo + 0.7 * hi), 1e-3).is_some()
+                }
+            };
+            assert_eq!(inverts, exact_on_grid(info), "{}", info.name);
+            listed += usize::from(inverts);
+        }
+        assert_eq!(listed, EXACT_ON_GRID.len());
     }
 }

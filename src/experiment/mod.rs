@@ -57,7 +57,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let space = ParamSpace::read(&sections, benchmark.info)?;
     let output = document::output(&sections)?;
     let reference = reference::read(sections.get("reference"), &space, benchmark.info, kind)?;
-    let measures = Measures::of(kind).with_reference(reference.is_some());
+    let measures = Measures::of_benchmark(benchmark.info).with_reference(reference.is_some());
     let expect = expect::read(sections.get("expect"), &space, measures)?;
     let figures = figures::read(sections.get("figures"), &space, kind, measures)?;
     let tables = tables::read(sections.get("tables"), &space, kind, measures)?;
@@ -110,10 +110,13 @@ pub struct Experiment {
 }
 
 impl Experiment {
-    /// The error fields and norms of its runs: those of its benchmark's kind, and the
-    /// relative error against the reference run when it names one.
+    /// The error fields and norms of its runs: those of its benchmark
+    /// (`Measures::of_benchmark`), and the relative error against the reference run when it
+    /// names one.
     pub fn measures(&self) -> Measures {
-        Measures::of(self.kind).with_reference(self.reference.is_some())
+        benchmarks::info(&self.benchmark)
+            .map_or(Measures::of(self.kind), Measures::of_benchmark)
+            .with_reference(self.reference.is_some())
     }
 }
 

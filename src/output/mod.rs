@@ -3,15 +3,27 @@
 
 use std::collections::BTreeMap;
 
-use crate::benchmarks::BenchmarkKind;
+use crate::benchmarks::{self, BenchmarkInfo, BenchmarkKind};
 use crate::params::Params;
 
 /// Bumped whenever a name or shape below changes meaning.
 pub const SCHEMA_VERSION: i64 = 2;
 
-/// The error fields, in the order they are written.
+/// The error fields at the particles, in the order they are written.
 pub const ERROR_FIELDS: [&str; 4] = ["displacement", "velocity", "stress", "density"];
-/// The error norms: `l2 = sqrt(sum_p V_p |e_p|^2)`, `rms = sqrt(sum_p |e_p|^2 / Np)`.
+/// The error of the grid velocity at the grid's DOFs against the exact velocity there.
+pub const GRID_VELOCITY: &str = "grid_velocity";
+/// The fields of a simulation whose benchmark knows the exact velocity on the grid
+/// (`benchmarks::exact_on_grid`).
+pub const ERROR_FIELDS_WITH_GRID: [&str; 5] = [
+    ERROR_FIELDS[0],
+    ERROR_FIELDS[1],
+    ERROR_FIELDS[2],
+    ERROR_FIELDS[3],
+    GRID_VELOCITY,
+];
+/// The error norms: `l2 = sqrt(sum_p V_p |e_p|^2)`, `rms = sqrt(sum_p |e_p|^2 / Np)` (for the
+/// grid velocity the sums run over the DOFs, with their quadrature weights).
 pub const NORMS: [&str; 2] = ["l2", "rms"];
 /// The norms with the relative l2 error against an experiment's reference run (computed by
 /// `collect`, never stored in a run file): ||f - f_ref|| / ||f_ref|| with the l2 norm above.
@@ -88,6 +100,20 @@ impl Measures {
                 fields: &SHAPE_FIELDS,
                 norms: &SHAPE_NORMS,
             },
+        }
+    }
+
+    /// The measures of a benchmark's runs: its kind's, with the grid velocity for simulations
+    /// that know the exact velocity on the grid.
+    pub fn of_benchmark(info: &BenchmarkInfo) -> Measures {
+        let measures = Measures::of(benchmarks::kind(info));
+        if measures.fields == ERROR_FIELDS && benchmarks::exact_on_grid(info) {
+            Measures {
+                fields: &ERROR_FIELDS_WITH_GRID,
+                ..measures
+            }
+        } else {
+            measures
         }
     }
 
@@ -279,7 +305,8 @@ pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
 pub use reader::{read_final_state, read_probes, read_summary};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
-    Conservation, Diagnostics, Errors, History, MethodParts, ParticleTable, RunRecord,
+    Conservation, Diagnostics, Errors, GridErrors, GridHistory, History, MethodParts,
+    ParticleTable, RunRecord,
 };
 pub use shape_functions::ShapeFunctionRecord;
 pub use writer::write_hdf5;

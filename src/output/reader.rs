@@ -7,7 +7,7 @@ use ndarray::s;
 
 use super::{
     elements, probes, reconstruction, shape_functions, ParticleState, ProbeRecord, RunStatus,
-    RunSummary, VelocityHistory, ERROR_FIELDS, NORMS,
+    RunSummary, VelocityHistory, ERROR_FIELDS_WITH_GRID, GRID_VELOCITY, NORMS,
 };
 use super::{
     ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS, SHAPE_FIELDS, SHAPE_NORMS,
@@ -165,12 +165,19 @@ fn velocity_history(file: &hdf5::File) -> hdf5::Result<Option<VelocityHistory>> 
 
 type FinalNorms = BTreeMap<(String, String), f64>;
 
+/// The final norms of every field; the grid velocity's only when the file has them (a file
+/// written before they existed leaves them out, and the report shows them empty).
 fn simulation_norms(file: &hdf5::File) -> hdf5::Result<FinalNorms> {
     let norms = file.group("errors/norms")?;
+    let written = norms.attr_names()?;
     let mut final_norms = BTreeMap::new();
-    for field in ERROR_FIELDS {
+    for field in ERROR_FIELDS_WITH_GRID {
         for norm in NORMS {
-            let value = read_f64(&norms, &format!("{norm}_{field}"))?;
+            let name = format!("{norm}_{field}");
+            if field == GRID_VELOCITY && !written.contains(&name) {
+                continue;
+            }
+            let value = read_f64(&norms, &name)?;
             final_norms.insert((field.to_string(), norm.to_string()), value);
         }
     }

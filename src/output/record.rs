@@ -21,6 +21,7 @@ pub struct RunRecord {
     pub wall_seconds: f64,
     pub particles: ParticleTable,
     pub history: History,
+    pub grid: GridHistory,
     pub errors: Errors,
     pub conservation: Conservation,
     pub diagnostics: Diagnostics,
@@ -85,6 +86,20 @@ pub struct History {
     pub density: Vec<f64>,
 }
 
+/// `/grid`: the DOFs of the grid's basis and their velocity at the history samples, which
+/// `/errors/grid_velocity` compares with the exact velocity.
+#[derive(Clone, Debug, Default)]
+pub struct GridHistory {
+    /// Nn x D positions of the DOFs.
+    pub x: Vec<f64>,
+    /// Nn quadrature weights of the grid-velocity norm: the trapezoidal rule over the DOFs.
+    pub weight: Vec<f64>,
+    /// Nt: the time each sample's grid velocity belongs to.
+    pub time: Vec<f64>,
+    /// Nt x Nn x D.
+    pub v: Vec<f64>,
+}
+
 /// `/errors`: pointwise error magnitudes and their norms at the history samples.
 #[derive(Clone, Debug, Default)]
 pub struct Errors {
@@ -96,6 +111,18 @@ pub struct Errors {
     pub l2: [Vec<f64>; 4],
     /// Per field: Nt values of sqrt(sum_p |e_p|^2 / Np).
     pub rms: [Vec<f64>; 4],
+    /// `GRID_VELOCITY` at the DOFs, with the weights of `/grid/weight`.
+    pub grid_velocity: GridErrors,
+}
+
+/// The grid-velocity error: Nt x Nn magnitudes |e_a| (NaN at a DOF where the exact velocity
+/// is unknown) and Nt values of each norm over the DOFs where it is known (NaN when at none):
+/// sqrt(sum_a w_a |e_a|^2) and sqrt(sum_a |e_a|^2 / Na).
+#[derive(Clone, Debug, Default)]
+pub struct GridErrors {
+    pub pointwise: Vec<f64>,
+    pub l2: Vec<f64>,
+    pub rms: Vec<f64>,
 }
 
 /// `/conservation`: mass totals at the history samples (the times are `/history/time`).

@@ -5,7 +5,8 @@ use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
 use super::{
-    elements, probes, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, SCHEMA_VERSION,
+    elements, probes, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, GRID_VELOCITY,
+    SCHEMA_VERSION,
 };
 use crate::params::ParamValue;
 
@@ -54,14 +55,33 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     dataset(&history, "stress", &r.history.stress, &[nt, np, d, d], "Pa")?;
     dataset(&history, "density", &r.history.density, &[nt, np], "kg/m^D")?;
 
+    let nn = r.grid.weight.len();
+    let grid = file.create_group("grid")?;
+    dataset(&grid, "x", &r.grid.x, &[nn, d], "m")?;
+    dataset(&grid, "weight", &r.grid.weight, &[nn], "m^D")?;
+    dataset(&grid, "time", &r.grid.time, &[nt], "s")?;
+    dataset(&grid, "v", &r.grid.v, &[nt, nn, d], "m/s")?;
+
     let errors = file.create_group("errors")?;
     dataset(&errors, "time", &r.history.time, &[nt], "s")?;
     dataset(&errors, "volume", &r.errors.volume, &[nt, np], "m^D")?;
     let norms = errors.create_group("norms")?;
-    for (f, field) in ERROR_FIELDS.iter().enumerate() {
+    let e = &r.errors;
+    let grid_velocity = &e.grid_velocity;
+    let fields = ERROR_FIELDS
+        .iter()
+        .enumerate()
+        .map(|(f, &field)| (field, np, &e.pointwise[f], [&e.l2[f], &e.rms[f]]))
+        .chain([(
+            GRID_VELOCITY,
+            nn,
+            &grid_velocity.pointwise,
+            [&grid_velocity.l2, &grid_velocity.rms],
+        )]);
+    for (field, points, pointwise, [l2, rms]) in fields {
         let unit = field_unit(field);
-        dataset(&errors, field, &r.errors.pointwise[f], &[nt, np], unit)?;
-        for (norm, values) in [("l2", &r.errors.l2[f]), ("rms", &r.errors.rms[f])] {
+        dataset(&errors, field, pointwise, &[nt, points], unit)?;
+        for (norm, values) in [("l2", l2), ("rms", rms)] {
             let name = format!("{norm}_{field}");
             dataset(&norms, &name, values, &[nt], unit)?;
             attr_f64(&norms, &name, values.last().copied().unwrap_or(f64::NAN))?;
@@ -132,7 +152,7 @@ fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
 fn field_unit(field: &str) -> &'static str {
     match field {
         "displacement" => "m",
-        "velocity" => "m/s",
+        "velocity" | GRID_VELOCITY => "m/s",
         "stress" => "Pa",
         _ => "kg/m^D",
     }

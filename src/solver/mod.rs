@@ -25,7 +25,7 @@ use crate::shape::{
     Stencils,
 };
 
-use recorder::Recorder;
+use recorder::{GridSample, Recorder};
 use transfer::Transfer;
 
 /// Runs one configuration. Never panics on bad numbers: a run that cannot start is
@@ -130,7 +130,7 @@ struct Run<'a, const D: usize> {
     /// The flat index of every particle's cell, after the last move.
     cells: Vec<usize>,
     grid_crossings: usize,
-    recorder: Recorder,
+    recorder: Recorder<D>,
 }
 
 impl<'a, const D: usize> Run<'a, D> {
@@ -148,6 +148,7 @@ impl<'a, const D: usize> Run<'a, D> {
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
         let mut recorder = Recorder::new();
         recorder.attach_probes(problem.as_ref(), &particles.x0);
+        recorder.attach_grid(&grid);
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
         let (basis, per_point) = match method.shape {
@@ -286,16 +287,16 @@ impl<'a, const D: usize> Run<'a, D> {
                 } else {
                     &self.particles.v
                 };
-                // In node order, so the total is the same on every run.
-                let grid_mass = self.nodes.mass.iter().sum();
-                self.recorder.sample(
-                    s,
-                    t,
-                    &self.particles,
-                    velocity,
-                    grid_mass,
-                    self.problem.as_ref(),
-                );
+                let (grid_velocity, grid_time) =
+                    sampled_grid_velocity(&self.method, &self.nodes, t, dt);
+                let grid = GridSample {
+                    // In node order, so the total is the same on every run.
+                    mass: self.nodes.mass.iter().sum(),
+                    velocity: grid_velocity,
+                    time: grid_time,
+                };
+                self.recorder
+                    .sample(s, t, &self.particles, velocity, grid, self.problem.as_ref());
             }
             if s == steps {
                 break;
@@ -460,6 +461,27 @@ impl<'a, const D: usize> Run<'a, D> {
     }
 }
 
+/// The nodal velocity a sample at time `t` compares with the exact one, and the time it
+/// belongs to: the grid solve's updated velocity, v_i^{s+1/2} at t + dt/2 where the velocities
+/// are half-step ones (the leapfrog, and MUSL or USL read as centred), v_i^{s+1} at t + dt for
+/// whole-step ones. The predictor-corrector solves its grid after the sample; its nodal
+/// velocity then is the predictor v_i^s + dt/2 a_i, the half-step velocity of the
+/// central-difference form of its Newmark scheme, at t + dt/2.
+fn sampled_grid_velocity<'a, const D: usize>(
+    method: &Method,
+    nodes: &'a GridState<D>,
+    t: f64,
+    dt: f64,
+) -> (&'a [SVector<f64, D>], f64) {
+    if method.integrator == IntegratorKind::PredictorCorrector {
+        (&nodes.velocity, t + 0.5 * dt)
+    } else if method.synchronises_samples() {
+        (&nodes.velocity_new, t + 0.5 * dt)
+    } else {
+        (&nodes.velocity_new, t + dt)
+    }
+}
+
 /// What a synchronised sample adds to the half-step velocity at step `s`: a^s dt / 2, or
 /// nothing at s = 0 where the particles still carry v^0.
 fn synchronising_half(s: usize, dt: f64) -> f64 {
@@ -481,7 +503,7 @@ struct Stepped<const D: usize> {
     /// On divergence, the step that failed and why.
     outcome: Result<(), (usize, Divergence)>,
     particles: Particles<D>,
-    recorder: Recorder,
+    recorder: Recorder<D>,
     diagnostics: Diagnostics,
 }
 
@@ -512,6 +534,7 @@ fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord 
         volume0: run.particles.volume0,
     };
     record.history = run.recorder.history;
+    record.grid = run.recorder.grid;
     record.errors = run.recorder.errors;
     record.conservation = run.recorder.conservation;
     record.probes = run.recorder.probes;
@@ -559,6 +582,7 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         wall_seconds: 0.0,
         particles: ParticleTable::default(),
         history: Default::default(),
+        grid: Default::default(),
         errors: Default::default(),
         conservation: Default::default(),
         diagnostics: Default::default(),

@@ -3,9 +3,13 @@ README ("HDF5 layout", schema_version 2), using h5py and numpy only.
 
 Besides names, types and shapes, it recomputes from the stored arrays:
   * the quadrature volumes  /errors/volume = volume0 * rho0 / density,
+  * the grid's DOFs, their trapezoidal weights /grid/weight and the time level /grid/time of
+    each sample's grid velocity,
   * every l2_* and rms_* norm and the final-value attributes of /errors/norms,
-  * the pointwise errors themselves, from /history and an independent implementation of
-    the manufactured solutions of Gong (mms1d_gong, mms2d_gong) and Tran (mms1d_tran),
+  * the pointwise errors themselves, from /history and /grid/v and an independent
+    implementation of the manufactured solutions of Gong (mms1d_gong, mms2d_gong) and Tran
+    (mms1d_tran), with the inverse motion by bisection for the grid velocity (the material
+    point at each DOF at the sample time, its velocity at /grid/time),
   * the mass totals of /conservation against /particles/mass,
 so that the exact solution and the error definitions are checked by a second implementation.
 
@@ -62,7 +66,12 @@ SIMULATION_FLOAT_ATTRS = ("dt", "t_end")
 STATUSES = ("ok", "diverged", "failed")
 
 FIELDS = ("displacement", "velocity", "stress", "density")
+GRID_FIELD = "grid_velocity"
 NORMS = ("l2", "rms")
+# Integrators whose grid solve gives the half-step velocity v^{s+1/2} at a sample (the
+# predictor-corrector's predictor included); MUSL and USL too when read as centred.
+HALF_STEP_INTEGRATORS = ("leapfrog", "predictor_corrector")
+CENTRED_INTEGRATORS = ("musl", "usl")
 
 MASS_UNITS = "kg"
 # Solvers that are not MPM (their run files have one point per element, no mapping).
@@ -359,8 +368,15 @@ def _expected_shapes(run):
         "/conservation/particle_mass": (n_t,),
         "/conservation/grid_mass": (n_t,),
     }
-    for field in FIELDS:
-        shapes[f"/errors/{field}"] = (n_e, n_p)
+    n_n = run.ds("/grid/weight").shape[0]
+    shapes.update({
+        "/grid/x": (n_n, d),
+        "/grid/weight": (n_n,),
+        "/grid/time": (n_t,),
+        "/grid/v": (n_t, n_n, d),
+    })
+    for field, points in [(f, n_p) for f in FIELDS] + [(GRID_FIELD, n_n)]:
+        shapes[f"/errors/{field}"] = (n_e, points)
         for norm in NORMS:
             shapes[f"/errors/norms/{norm}_{field}"] = (n_e,)
     return shapes
@@ -519,15 +535,30 @@ def test_norms(run):
     run.require_data()
     volume = run.ds("/errors/volume")
     n_p = volume.shape[1]
+    grid_weight = run.ds("/grid/weight")[None, :]
+    n_n = grid_weight.shape[1]
     final = run.group("/errors/norms")
-    for field in FIELDS:
+    for field in FIELDS + (GRID_FIELD,):
         e = run.ds(f"/errors/{field}")
         finite = np.isfinite(e)
         assert np.all(e[finite] >= 0), f"/errors/{field} holds negative magnitudes"
-        recomputed = {
-            "l2": np.sqrt(np.sum(volume * e**2, axis=1)),
-            "rms": np.sqrt(np.sum(e**2, axis=1) / n_p),
-        }
+        if field == GRID_FIELD:
+            # Over the DOFs where the exact velocity is known: all of them for the manufactured
+            # solutions, none (NaN norms) elsewhere.
+            if run.attrs["benchmark"] not in BENCHMARKS or n_n == 0:
+                assert np.all(np.isnan(e)), "a grid-velocity error without an exact one"
+                nan = np.full(e.shape[0], np.nan)
+                recomputed = {"l2": nan, "rms": nan}
+            else:
+                recomputed = {
+                    "l2": np.sqrt(np.sum(grid_weight * e**2, axis=1)),
+                    "rms": np.sqrt(np.sum(e**2, axis=1) / n_n),
+                }
+        else:
+            recomputed = {
+                "l2": np.sqrt(np.sum(volume * e**2, axis=1)),
+                "rms": np.sqrt(np.sum(e**2, axis=1) / n_p),
+            }
         for norm in NORMS:
             name = f"{norm}_{field}"
             stored = run.ds(f"/errors/norms/{name}")
@@ -544,6 +575,72 @@ def test_norms(run):
                 value, stored[-1], rtol=RTOL_STORED, atol=0, equal_nan=True,
                 err_msg=f"final value attribute {name}",
             )
+
+
+def _axis_coordinates(x, d, per_axis):
+    """The DOF coordinates along each axis of a lattice numbered with the first axis fastest."""
+    strides = [per_axis**k for k in range(d)]
+    return [x[[i * strides[k] for i in range(per_axis)], k] for k in range(d)]
+
+
+def test_grid_dofs_and_weights(run):
+    """/grid/x is the lattice of the basis' DOFs (the nodes, or the quadratic B-spline's
+    Greville abscissae 0, h/2, 3h/2, ..., L - h/2, L), first axis fastest, and /grid/weight the
+    trapezoidal rule over it, which sums to the volume of the grid."""
+    run.require_data()
+    a = run.attrs
+    x = run.ds("/grid/x")
+    weight = run.ds("/grid/weight")
+    assert run.units["/grid/x"] == "m" and run.units["/grid/weight"] == "m^D"
+    if a["method"] in REFERENCE_METHODS:
+        assert x.shape[0] == 0, "a reference solver has no grid"
+        return
+    d, h = int(a["dim"]), float(a["h"])
+    spline = str(a["shape"]) == "quadratic-bspline"
+    # The grid may reach beyond the body (empty cells for it to move into), so its cells are
+    # read from the lattice, not from the `cells` parameter.
+    per_axis = int(round(x.shape[0] ** (1.0 / d)))
+    assert x.shape[0] == per_axis**d, f"{x.shape[0]} DOFs are not a {d}-dimensional lattice"
+    cells = per_axis - (2 if spline else 1)
+    assert cells >= int(a["cells"]), f"{cells} grid cells for a body of {a['cells']}"
+    lower = x[0]
+    steps = np.concatenate(([0.0], np.arange(per_axis - 2) + 0.5, [cells])) if spline else (
+        np.arange(per_axis, dtype=float)
+    )
+    axes = _axis_coordinates(x, d, per_axis)
+    for k in range(d):
+        np.testing.assert_allclose(
+            axes[k], lower[k] + steps * h, rtol=0, atol=1e-12 * cells * h,
+            err_msg=f"/grid/x along axis {k}",
+        )
+    index = np.arange(per_axis**d)
+    expected = np.ones(per_axis**d)
+    for k in range(d):
+        c = axes[k]
+        w = 0.5 * (np.append(c[1:], c[-1]) - np.insert(c[:-1], 0, c[0]))
+        expected *= w[(index // per_axis**k) % per_axis]
+    np.testing.assert_allclose(weight, expected, rtol=RTOL_STORED, err_msg="/grid/weight")
+    np.testing.assert_allclose(weight.sum(), (cells * h) ** d, rtol=1e-12)
+
+
+def test_grid_time(run):
+    """The grid velocity of a sample belongs to t + dt/2 where velocities are half-step ones
+    and to t + dt where they are whole-step ones."""
+    run.require_data()
+    a = run.attrs
+    if a["method"] in REFERENCE_METHODS:
+        pytest.skip("a reference solver has no grid")
+    sampled = run.group("/params").get("sampled_velocity", "stepped")
+    integrator = str(a["integrator"])
+    half = integrator in HALF_STEP_INTEGRATORS or (
+        integrator in CENTRED_INTEGRATORS and sampled == "centred"
+    )
+    lag = 0.5 if half else 1.0
+    np.testing.assert_allclose(
+        run.ds("/grid/time"), run.ds("/history/time") + lag * a["dt"], rtol=1e-12,
+        err_msg=f"/grid/time of integrator {integrator}",
+    )
+    assert run.units["/grid/time"] == "s" and run.units["/grid/v"] == "m/s"
 
 
 # --------------------------------------------------------------------------------------------
@@ -629,6 +726,23 @@ def sine_exact(X, t, w):
     return u, v, sigma, w.rho0 / j
 
 
+def grid_exact_velocity(x, t, t_v, w):
+    """The exact velocity at times t_v (Nt,) of the material points at x (Nn, D) at times t
+    (Nt,), (Nt, Nn, D): X with X + A sin(k X) sin(omega t) = x per axis found by bisection on
+    [x - |b|, x + |b|] (b = A sin(omega t)), where the increasing left side brackets x, then
+    omega A sin(k X) cos(omega t_v)."""
+    b = (w.amplitude * np.sin(w.omega * t))[:, None, None]
+    target = np.broadcast_to(x[None], (t.shape[0],) + x.shape)
+    lo, hi = target - np.abs(b), target + np.abs(b)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        above = mid + b * np.sin(w.k * mid) > target
+        hi = np.where(above, mid, hi)
+        lo = np.where(above, lo, mid)
+    X = 0.5 * (lo + hi)
+    return w.omega * w.amplitude * np.sin(w.k * X) * np.cos(w.omega * t_v)[:, None, None]
+
+
 def _check_pointwise(name, stored, recomputed, numerical, exact):
     finite = np.isfinite(numerical) & np.isfinite(exact)
     scale = max(np.max(np.abs(numerical[finite]), initial=0), np.max(np.abs(exact), initial=0))
@@ -659,6 +773,11 @@ def test_exact_errors(run):
     }
     for field, (numerical, exact, recomputed) in pairs.items():
         _check_pointwise(field, run.ds(f"/errors/{field}"), recomputed, numerical, exact)
+    x = run.ds("/grid/x")
+    grid_v = run.ds("/grid/v")
+    exact = grid_exact_velocity(x, t, run.ds("/grid/time"), BENCHMARKS[benchmark].wave(run))
+    recomputed = np.linalg.norm(grid_v - exact, axis=-1)
+    _check_pointwise(GRID_FIELD, run.ds(f"/errors/{GRID_FIELD}"), recomputed, grid_v, exact)
     if run.status == "ok":
         # At t = 0 the particles sit at X with the exact initial velocity and zero stress.
         np.testing.assert_array_equal(run.ds("/errors/displacement")[0], 0.0)
