@@ -35,6 +35,7 @@ points and at the plot and map samples, the RMS error and the relative integral 
 Without the variable, or with no *.h5 file under it, the suite fails (it never passes empty).
 """
 
+import csv
 import os
 import re
 from pathlib import Path
@@ -1610,8 +1611,11 @@ def test_probe_references_by_a_second_implementation(run):
 
 
 # A convergence figure's series label: "<field>, <axis>=<value>, ... (rate r)".
+# `<field>[ (<unit>)][, <axis>=<value>...][ (rate r)][ (on top of <series>)]`: the unit when
+# the figure shows several fields, the note when an earlier series hides this one.
 CONVERGENCE_LABEL = re.compile(
-    r"^(?P<field>[a-z]+)(?P<axes>(, [a-z_]+=[^,()]+)*)( \(rate [-0-9.na]+\))?$"
+    r"^(?P<field>[a-z_]+)( \([^()]*\))?(?P<axes>(, [a-z_]+=[^,()]+)*)( \(rate [-0-9.na]+\))?"
+    r"( \(on top of [^()]*\))?$"
 )
 
 
@@ -1679,13 +1683,11 @@ def test_convergence_figure_data_matches_the_run_files():
     assert figures, "the reduced bar's report wrote no figure data"
     checked = 0
     for data in figures:
-        lines = data.read_text().splitlines()
-        header = lines[0].split(",")
+        rows = list(csv.reader(data.read_text().splitlines()))
+        header = rows[0]
         assert header[:2] == ["series", "role"], f"{data.name}: header {header}"
         norm = header[3].split()[0]
-        for row in lines[1:]:
-            label, role, x, y = row.rsplit(",", 3)
-            label = label.strip('"')
+        for label, role, x, y in rows[1:]:
             if role != "marker":
                 continue
             m = CONVERGENCE_LABEL.match(label)
