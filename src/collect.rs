@@ -10,7 +10,9 @@ use std::path::Path;
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::{self, Experiment};
 use crate::experiment::{FigureKind, TableKind};
-use crate::output::{read_final_state, read_probes, read_summary, run_path, Profile, RunSummary};
+use crate::output::{
+    read_final_state, read_probes, read_summary, run_path, ParticleState, RunSummary,
+};
 use crate::runner::EXPERIMENT_COPY;
 
 pub struct Collected {
@@ -41,7 +43,7 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
                 None
             };
             if wants_profiles(&experiment) {
-                run.profile = state.as_ref().map(Profile::from_state);
+                run.profile = state.as_ref().map(ParticleState::along_x);
             }
             if draws_particle_maps(&experiment) {
                 run.final_state = state.filter(|s| s.dim == 2);

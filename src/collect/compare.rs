@@ -3,7 +3,7 @@
 //! linearly through the reference's points (element centroids for ULFEM) and extended
 //! linearly beyond the first and last of them.
 
-use crate::output::{Profile, RunStatus, RunSummary, ERROR_FIELDS, REFERENCE_NORM};
+use crate::output::{ParticleState, RunStatus, RunSummary, ERROR_FIELDS, REFERENCE_NORM};
 use crate::params::Params;
 
 /// Sets every run's `reference` norm of each field: sqrt(sum_p V_p (f_p - f_ref(X_p))^2) /
@@ -34,7 +34,7 @@ pub fn attach_reference_errors(select: &Params, runs: &mut [RunSummary]) {
     }
 }
 
-fn relative_error(run: &Profile, reference: &Profile, field: &str) -> f64 {
+fn relative_error(run: &ParticleState, reference: &ParticleState, field: &str) -> f64 {
     let values = run.field(field);
     let table = Interpolant::new(&reference.x0, &reference.field(field));
     let (mut difference, mut size) = (0.0, 0.0);
@@ -82,8 +82,10 @@ mod tests {
         assert_eq!(t.at(1.0), 4.0);
     }
 
-    fn profile(x0: &[f64], stress: &[f64]) -> Profile {
-        Profile {
+    fn profile(x0: &[f64], stress: &[f64]) -> ParticleState {
+        ParticleState {
+            dim: 1,
+            time: 1.0,
             x0: x0.to_vec(),
             x: x0.to_vec(),
             velocity: vec![0.0; x0.len()],

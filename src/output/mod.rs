@@ -190,9 +190,10 @@ pub struct RunSummary {
     /// mappings); NaN for a run that has none.
     pub max_mass_error: f64,
     pub max_momentum_error: f64,
-    /// The state at the last sample of a 1D simulation run, when the report compares runs
-    /// with a reference run or draws fields along the bar (`collect` fills it).
-    pub profile: Option<Profile>,
+    /// The state along x at the last sample of a simulation run (`ParticleState::along_x`),
+    /// when the report compares runs with a reference run or draws fields along the bar
+    /// (`collect` fills it).
+    pub profile: Option<ParticleState>,
     /// The `/probes` of a simulation run, when the report draws their histories (`collect`
     /// fills it); empty otherwise.
     pub probes: Vec<ProbeRecord>,
@@ -236,36 +237,25 @@ impl ParticleState {
     }
 }
 
-/// The last sample of a 1D simulation run, one value per particle (per element for a
-/// reference solver), from `/particles`, `/history` and `/errors/volume`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Profile {
-    /// Reference positions X_p.
-    pub x0: Vec<f64>,
-    pub x: Vec<f64>,
-    pub velocity: Vec<f64>,
-    pub stress: Vec<f64>,
-    pub density: Vec<f64>,
-    /// Current volumes, the quadrature weights of the l2 norm.
-    pub volume: Vec<f64>,
-}
-
-impl Profile {
-    /// The first component of every vector and tensor of a state, the whole state in 1D.
-    pub fn from_state(state: &ParticleState) -> Profile {
-        let d = state.dim;
+impl ParticleState {
+    /// The state along x: the first component of every vector and tensor, as a 1D state (the
+    /// whole state of a 1D run).
+    pub fn along_x(&self) -> ParticleState {
+        let d = self.dim;
         let first = |values: &[f64], per: usize| values.iter().step_by(per).copied().collect();
-        Profile {
-            x0: first(&state.x0, d),
-            x: first(&state.x, d),
-            velocity: first(&state.velocity, d),
-            stress: first(&state.stress, d * d),
-            density: state.density.clone(),
-            volume: state.volume.clone(),
+        ParticleState {
+            dim: 1,
+            time: self.time,
+            x0: first(&self.x0, d),
+            x: first(&self.x, d),
+            velocity: first(&self.velocity, d),
+            stress: first(&self.stress, d * d),
+            density: self.density.clone(),
+            volume: self.volume.clone(),
         }
     }
 
-    /// The values of an error field (`displacement` is x - X).
+    /// The values of an error field along x (`displacement` is x - X) of a 1D state.
     pub fn field(&self, field: &str) -> Vec<f64> {
         match field {
             "displacement" => self.x.iter().zip(&self.x0).map(|(x, x0)| x - x0).collect(),

@@ -3,7 +3,7 @@
 
 use super::{default_stem, Figure, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec, Selection};
-use crate::output::{Profile, RunStatus, RunSummary};
+use crate::output::{ParticleState, RunStatus, RunSummary};
 use crate::report::group::{label, ordered_runs, selects};
 use crate::report::units::quantity;
 
@@ -91,7 +91,7 @@ fn differing(lines: &[&RunSummary], run: &RunSummary) -> String {
 }
 
 /// (x_p, f_p) in order of x.
-fn along(profile: &Profile, field: &str) -> Vec<(f64, f64)> {
+fn along(profile: &ParticleState, field: &str) -> Vec<(f64, f64)> {
     let mut points: Vec<(f64, f64)> = profile
         .x
         .iter()
