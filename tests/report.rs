@@ -370,17 +370,12 @@ fn report_files_are_written_and_deterministic() {
 #[test]
 fn figure_specs_split_by_the_remaining_axes() {
     let figure = FigureSpec {
-        kind: FigureKind::Convergence,
-        fields: vec!["velocity".into(), "stress".into()],
-        norm: "rms".into(),
         by: vec!["G".into()],
-        select: Selection::default(),
-        stability: None,
-        probe: None,
-        name: None,
-        title: None,
-        paper: None,
-        map: None,
+        ..FigureSpec::new(
+            FigureKind::Convergence,
+            vec!["velocity".into(), "stress".into()],
+            "rms",
+        )
     };
     let exp = experiment(vec![], vec![figure.clone(), figure]);
     let (dir, names) = figure_names(&exp);
@@ -401,17 +396,11 @@ fn figure_specs_split_by_the_remaining_axes() {
 #[test]
 fn named_figures_take_their_name_title_and_paper() {
     let figure = FigureSpec {
-        kind: FigureKind::Convergence,
-        fields: vec!["velocity".into()],
-        norm: "rms".into(),
         by: vec!["G".into()],
-        select: Selection::default(),
-        stability: None,
-        probe: None,
         name: Some("fig4_7".into()),
         title: Some("MPM convergence".into()),
         paper: Some("Gong 2015, Fig 4.7".into()),
-        map: None,
+        ..FigureSpec::new(FigureKind::Convergence, vec!["velocity".into()], "rms")
     };
     let exp = experiment(vec![], vec![figure]);
     let (dir, names) = figure_names(&exp);
@@ -455,17 +444,8 @@ fn figure_names(exp: &Experiment) -> (tempfile::TempDir, Vec<String>) {
 #[test]
 fn single_field_figures_are_named_by_their_field() {
     let spec = |field: &str| FigureSpec {
-        kind: FigureKind::Convergence,
-        fields: vec![field.into()],
-        norm: "rms".into(),
         by: vec!["method".into(), "G".into()],
-        select: Selection::default(),
-        stability: None,
-        probe: None,
-        name: None,
-        title: None,
-        paper: None,
-        map: None,
+        ..FigureSpec::new(FigureKind::Convergence, vec![field.into()], "rms")
     };
     let exp = experiment(vec![], vec![spec("velocity"), spec("stress")]);
     let (_dir, names) = figure_names(&exp);
@@ -542,17 +522,9 @@ fn probed(method: &str, status: RunStatus) -> RunSummary {
 
 fn history(probe: &str) -> FigureSpec {
     FigureSpec {
-        kind: FigureKind::History,
-        fields: Vec::new(),
-        norm: "l2".into(),
         by: vec!["method".into()],
-        select: Selection::default(),
-        stability: None,
         probe: Some(probe.into()),
-        name: None,
-        title: None,
-        paper: None,
-        map: None,
+        ..FigureSpec::new(FigureKind::History, Vec::new(), "l2")
     }
 }
 
@@ -669,19 +641,12 @@ fn mapped(g: &str, method: &str, yy: [f64; 2]) -> RunSummary {
 
 fn field_map(field: &str) -> FigureSpec {
     FigureSpec {
-        kind: FigureKind::FieldMap,
-        fields: Vec::new(),
-        norm: "l2".into(),
         by: vec!["method".into()],
-        select: Selection::default(),
-        stability: None,
-        probe: None,
-        name: None,
-        title: None,
         paper: Some("Paper, Fig 1".into()),
         map: Some(FieldMapSpec {
             field: field.into(),
         }),
+        ..FigureSpec::new(FigureKind::FieldMap, Vec::new(), "l2")
     }
 }
 

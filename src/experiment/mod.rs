@@ -268,6 +268,25 @@ pub struct FigureSpec {
     pub map: Option<FieldMapSpec>,
 }
 
+impl FigureSpec {
+    /// A figure of `kind` over every run: no `by`, selector, name or kind-specific part.
+    pub fn new(kind: FigureKind, fields: Vec<String>, norm: &str) -> Self {
+        FigureSpec {
+            name: None,
+            title: None,
+            paper: None,
+            kind,
+            fields,
+            norm: norm.to_string(),
+            by: Vec::new(),
+            select: Selection::default(),
+            stability: None,
+            probe: None,
+            map: None,
+        }
+    }
+}
+
 /// What a field map draws.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FieldMapSpec {

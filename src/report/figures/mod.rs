@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use super::group::{label, selects, slug};
 use crate::benchmarks::BenchmarkKind;
-use crate::experiment::{Experiment, FigureKind, FigureSpec, Selection};
+use crate::experiment::{Experiment, FigureKind, FigureSpec};
 use crate::output::RunSummary;
 
 pub use field_map::{Cell, FieldMap, Panel};
@@ -119,23 +119,13 @@ pub struct Figure {
 /// are left out. A history figure of a probe no run records is an error.
 pub fn plan(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Figure>, String> {
     let measures = experiment.measures();
-    let default = [FigureSpec {
-        kind: if experiment.kind == BenchmarkKind::ShapeFunctions {
-            FigureKind::ShapeFunctions
-        } else {
-            FigureKind::Convergence
-        },
-        fields: measures.fields.iter().map(|f| f.to_string()).collect(),
-        norm: measures.norms[0].to_string(),
-        by: Vec::new(),
-        select: Selection::default(),
-        stability: None,
-        probe: None,
-        name: None,
-        title: None,
-        paper: None,
-        map: None,
-    }];
+    let kind = if experiment.kind == BenchmarkKind::ShapeFunctions {
+        FigureKind::ShapeFunctions
+    } else {
+        FigureKind::Convergence
+    };
+    let fields = measures.fields.iter().map(|f| f.to_string()).collect();
+    let default = [FigureSpec::new(kind, fields, measures.norms[0])];
     let specs = if experiment.figures.is_empty() {
         &default[..]
     } else {
