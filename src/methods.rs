@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
+use crate::benchmarks::scattered::MAX_GAUSS_POINTS;
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
 use crate::params::{get_f64, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{
@@ -647,6 +649,7 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
         if params.contains_key(GAUSS_POINTS_KEY) {
             recipe.gauss_points = get_usize(params, GAUSS_POINTS_KEY)?;
         }
+        check_gauss_points(recipe.gauss_points, params, dim)?;
         if params.contains_key(BODY_FORCE_FIT_KEY) {
             let name = get_str(params, BODY_FORCE_FIT_KEY)?;
             recipe.body_force = BodyForceFit::from_name(name).ok_or_else(|| {
@@ -751,6 +754,38 @@ fn runs_with(method: &Method, integrator: IntegratorKind) -> bool {
             integrator != IntegratorKind::PredictorCorrector
         }
     }
+}
+
+/// The quadrature transfers fit the fields at `gauss_points` per cell and axis of the grid:
+/// at most `MAX_GAUSS_POINTS`, and at most `MAX_POINTS` in all.
+fn check_gauss_points(gauss_points: usize, params: &Params, dim: usize) -> Result<(), ParamError> {
+    if gauss_points > MAX_GAUSS_POINTS {
+        return Err(ParamError::new(
+            GAUSS_POINTS_KEY,
+            format!(
+                "{GAUSS_POINTS_KEY} = {gauss_points}: at most {MAX_GAUSS_POINTS} Gauss points per \
+                 cell and axis"
+            ),
+        ));
+    }
+    let cells = get_usize(params, "cells")?;
+    let extra = match params.get("extra_cells") {
+        Some(_) => get_usize(params, "extra_cells")?,
+        None => 0,
+    };
+    let per_axis = cells
+        .checked_add(extra)
+        .and_then(|n| n.checked_mul(gauss_points));
+    check_count(
+        per_axis.and_then(|n| per_axis_total(n, dim)),
+        "Gauss points",
+        &format!(
+            "((cells + extra_cells) {GAUSS_POINTS_KEY}){} with cells = {cells}, extra_cells = \
+             {extra} and {GAUSS_POINTS_KEY} = {gauss_points}",
+            power(dim)
+        ),
+        largest(&[("cells", cells), (GAUSS_POINTS_KEY, gauss_points)]),
+    )
 }
 
 fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {

@@ -13,13 +13,12 @@ use std::f64::consts::PI;
 
 use nalgebra::{SMatrix, SVector, Vector2};
 
-use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem};
+use super::limits::{check_lattice, courant_time_step};
+use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_str, get_usize};
 use crate::particles::Placement;
-
-use super::sine_mms::fit_time_step;
 
 /// Values of `placement`: the Gauss points of each cell (the paper's choice for the hat and
 /// LME), or the sub-cell centres (its choice for uGIMP, whose domains must not overlap).
@@ -114,9 +113,12 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
                   top_displacement, bottom_stress",
     params: PARAMS,
     check: check_params,
+    time_step: Some(time_step),
 };
 
+/// The size of the run, the explicit scheme's Courant bound, and a static strain below 1.
 fn check_params(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, 2, "particles")?;
     courant_number(params)?;
     let block = AndersenBlock::new(params)?;
     let strain = block.rho0 * block.gravity.abs() * block.height / block.young;
@@ -149,25 +151,19 @@ pub struct AndersenBlock {
 
 impl AndersenBlock {
     fn new(params: &Params) -> Result<Self, ParamError> {
-        let height = get_f64(params, "H")?;
-        let cells = get_usize(params, "cells")?;
-        let rho0 = get_f64(params, "rho0")?;
-        let young = get_f64(params, "E")?;
-        let c = (young / rho0).sqrt();
-        let h = height / cells as f64;
-        let (dt, steps) = fit_time_step(get_f64(params, "cfl")? * h / c, get_f64(params, "t_end")?);
+        let TimeStep { dt, steps } = time_step(params)?;
         let placement = match get_str(params, "placement")? {
             "centres" => Placement::SubCellCentres,
             _ => Placement::Gauss,
         };
         Ok(AndersenBlock {
-            height,
-            cells,
+            height: get_f64(params, "H")?,
+            cells: get_usize(params, "cells")?,
             extra_cells: get_usize(params, "extra_cells")?,
             ppc: get_usize(params, "ppc")?,
             placement,
-            rho0,
-            young,
+            rho0: get_f64(params, "rho0")?,
+            young: get_f64(params, "E")?,
             gravity: get_f64(params, "g")?,
             period: get_f64(params, "T")?,
             dt,
@@ -184,6 +180,11 @@ impl AndersenBlock {
             self.gravity
         }
     }
+}
+
+/// dt = cfl h / c over the block's cells, with c = sqrt(E/rho0).
+fn time_step(params: &Params) -> Result<TimeStep, ParamError> {
+    courant_time_step(params, PARAMS, get_f64(params, "H")?)
 }
 
 /// Builds the block from validated parameters.

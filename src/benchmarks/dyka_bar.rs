@@ -10,8 +10,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::sine_mms::fit_time_step;
-use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem};
+use super::limits::{check_lattice, courant_time_step};
+use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_usize};
@@ -90,10 +90,13 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
                   free_end_velocity, quarter_stress, mid_stress",
     params: PARAMS,
     check: check_params,
+    time_step: Some(time_step),
 };
 
-/// The explicit scheme's Courant bound, and a strain that keeps the exact density finite.
+/// The size of the run, the explicit scheme's Courant bound, and a strain that keeps the
+/// exact density finite.
 fn check_params(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, 1, "particles")?;
     let bar = DykaBar::new(params)?;
     courant_number(params)?;
     let strain = bar.v0.abs() / bar.wave_speed();
@@ -125,19 +128,14 @@ pub struct DykaBar {
 impl DykaBar {
     fn new(params: &Params) -> Result<Self, ParamError> {
         let length = get_f64(params, "L")?;
-        let cells = get_usize(params, "cells")?;
-        let rho0 = get_f64(params, "rho0")?;
-        let young = get_f64(params, "E")?;
-        let c = (young / rho0).sqrt();
-        let h = length / cells as f64;
-        let (dt, steps) = fit_time_step(get_f64(params, "cfl")? * h / c, get_f64(params, "t_end")?);
+        let TimeStep { dt, steps } = time_step(params)?;
         Ok(DykaBar {
             length,
-            cells,
+            cells: get_usize(params, "cells")?,
             extra_cells: get_usize(params, "extra_cells")?,
             ppc: get_usize(params, "ppc")?,
-            rho0,
-            young,
+            rho0: get_f64(params, "rho0")?,
+            young: get_f64(params, "E")?,
             v0: get_f64(params, "v0")?,
             dt,
             steps,
@@ -192,6 +190,11 @@ impl DykaBar {
             on_bar(y)
         }
     }
+}
+
+/// dt = cfl h / c over the bar's cells, with c = sqrt(E/rho0).
+fn time_step(params: &Params) -> Result<TimeStep, ParamError> {
+    courant_time_step(params, PARAMS, get_f64(params, "L")?)
 }
 
 /// Builds the bar from validated parameters.

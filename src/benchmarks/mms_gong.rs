@@ -5,8 +5,9 @@
 
 use std::f64::consts::PI;
 
+use super::limits::{check_lattice, courant_time_step};
 use super::sine_mms::{SineMms, SineMmsSpec, SineWave, CELLS, PPC, RHO0};
-use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params};
+use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{lame_from_young, NeoHookean};
 use crate::params::{get_f64, get_usize};
 
@@ -64,7 +65,8 @@ pub const INFO_1D: BenchmarkInfo = BenchmarkInfo {
     source: "Gong 2015, eqs 4.35-4.39",
     description: "neo-Hookean bar on [0,1], fixed ends, manufactured solution",
     params: PARAMS,
-    check: check_params,
+    check: check_params::<1>,
+    time_step: Some(time_step),
 };
 
 pub const INFO_2D: BenchmarkInfo = BenchmarkInfo {
@@ -73,11 +75,14 @@ pub const INFO_2D: BenchmarkInfo = BenchmarkInfo {
     source: "Gong 2015, eqs 4.41-4.46",
     description: "plane-strain neo-Hookean square [0,1]^2, roller walls, manufactured solution",
     params: PARAMS,
-    check: check_params,
+    check: check_params::<2>,
+    time_step: Some(time_step),
 };
 
-/// Admissibility checks that involve several parameters.
-fn check_params(params: &Params) -> Result<(), ParamError> {
+/// The size of the run in `D` dimensions, and admissibility checks that involve several
+/// parameters.
+fn check_params<const D: usize>(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, D, "particles")?;
     let g = get_f64(params, "G")?;
     if g.abs() * PI >= 1.0 {
         return Err(ParamError::new(
@@ -122,7 +127,12 @@ fn check_params(params: &Params) -> Result<(), ParamError> {
             ),
         ));
     }
-    Ok(())
+    time_step(params).map(drop)
+}
+
+/// dt = cfl h / c on the unit box, with the phase speed c = sqrt(E/rho0).
+fn time_step(params: &Params) -> Result<TimeStep, ParamError> {
+    courant_time_step(params, PARAMS, 1.0)
 }
 
 /// Gong's parameter set of sec 4.6 (E = 1e7, nu = 0.3, rho0 = 1e3, t_end = 0.02, cfl = 0.4)
@@ -147,7 +157,7 @@ pub fn thesis_params(g: f64, cells: i64, ppc: i64) -> Params {
 
 /// Gong's problem in `D` dimensions: the unit box, k = pi, phase speed c = sqrt(E/rho0).
 pub fn gong_mms<const D: usize>(params: &Params) -> Result<SineMms<D>, ParamError> {
-    check_params(params)?;
+    check_params::<D>(params)?;
     let e = get_f64(params, "E")?;
     let nu = get_f64(params, "nu")?;
     let rho0 = get_f64(params, "rho0")?;
@@ -166,8 +176,7 @@ pub fn gong_mms<const D: usize>(params: &Params) -> Result<SineMms<D>, ParamErro
         material: NeoHookean { lambda, mu },
         cells,
         ppc: get_usize(params, "ppc")?,
-        dt_max: get_f64(params, "cfl")? * (length / cells as f64) / c,
-        t_end: get_f64(params, "t_end")?,
+        step: time_step(params)?,
     }))
 }
 
@@ -210,9 +219,9 @@ mod tests {
     fn rejects_unstable_cfl_and_inverting_amplitude() {
         let mut p = thesis_params(0.1, 8, 2);
         p.insert("cfl".into(), ParamValue::Float(0.9));
-        assert_eq!(check_params(&p).unwrap_err().key, "cfl");
+        assert_eq!(check_params::<1>(&p).unwrap_err().key, "cfl");
         let p = thesis_params(0.4, 8, 2);
-        assert_eq!(check_params(&p).unwrap_err().key, "G");
+        assert_eq!(check_params::<1>(&p).unwrap_err().key, "G");
     }
 
     #[test]
@@ -220,13 +229,13 @@ mod tests {
         // nu = 0.3: c_p = 1.1602 c, so cfl 1.2 is the Courant number 1.392.
         let mut p = thesis_params(1e-4, 8, 2);
         p.insert("cfl".into(), ParamValue::Float(1.2));
-        let e = check_params(&p).unwrap_err();
+        let e = check_params::<1>(&p).unwrap_err();
         assert!(e.message.contains("Use cfl <= 0.8619"), "{e}");
         assert!(e.message.contains("raise courant_limit"), "{e}");
         p.insert("courant_limit".into(), ParamValue::Float(1.5));
-        assert!(check_params(&p).is_ok());
+        assert!(check_params::<1>(&p).is_ok());
         p.insert("cfl".into(), ParamValue::Float(1.3));
-        let e = check_params(&p).unwrap_err();
+        let e = check_params::<1>(&p).unwrap_err();
         assert_eq!(e.key, "cfl");
         assert!(
             e.message.contains("> 1.5") && e.message.contains("Use cfl <= 1.2928"),

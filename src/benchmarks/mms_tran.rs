@@ -4,8 +4,9 @@
 
 use std::f64::consts::PI;
 
+use super::limits::{check_lattice, given_time_step};
 use super::sine_mms::{SineMms, SineMmsSpec, SineWave, CELLS, PPC, RHO0};
-use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params};
+use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{young_from_lame, NeoHookean};
 use crate::params::{get_f64, get_usize};
 
@@ -64,10 +65,12 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     description: "neo-Hookean bar on [0,L], fixed ends, manufactured solution",
     params: PARAMS,
     check: check_params,
+    time_step: Some(time_step),
 };
 
-/// Admissibility checks that involve several parameters.
+/// The size of the run, and admissibility checks that involve several parameters.
 fn check_params(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, 1, "particles")?;
     let a = get_f64(params, "A")?;
     let length = get_f64(params, "L")?;
     let strain = 2.0 * PI * a.abs() / length;
@@ -100,7 +103,12 @@ fn check_params(params: &Params) -> Result<(), ParamError> {
             ),
         ));
     }
-    Ok(())
+    time_step(params).map(drop)
+}
+
+/// The given dt, fitted to t_end.
+fn time_step(params: &Params) -> Result<TimeStep, ParamError> {
+    given_time_step(params, PARAMS)
 }
 
 fn material(params: &Params) -> Result<NeoHookean, ParamError> {
@@ -128,8 +136,7 @@ pub fn tran_mms(params: &Params) -> Result<SineMms<1>, ParamError> {
         material,
         cells: get_usize(params, "cells")?,
         ppc: get_usize(params, "ppc")?,
-        dt_max: get_f64(params, "dt")?,
-        t_end: get_f64(params, "t_end")?,
+        step: time_step(params)?,
     }))
 }
 

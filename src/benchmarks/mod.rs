@@ -5,6 +5,7 @@
 
 mod andersen_block;
 mod dyka_bar;
+pub(crate) mod limits;
 mod mms_gong;
 mod mms_tran;
 pub mod scattered;
@@ -18,6 +19,7 @@ use crate::material::Material;
 use crate::params::{ParamError, ParamValue, Params};
 use crate::particles::Placement;
 
+pub use limits::{TimeStep, LIMIT_PARAMS, MAX_POINTS, MAX_STEPS, MAX_STEPS_KEY};
 pub use mms_gong::{gong_mms, thesis_params};
 pub use sine_mms::SineMms;
 pub use vibrating_bar::{vibrating_bar, VibratingBar};
@@ -80,7 +82,13 @@ pub struct BenchmarkInfo {
     /// Checks that need several parameters at once (stability, physical admissibility).
     /// Called with every parameter present and of the right kind.
     pub check: fn(&Params) -> Result<(), ParamError>,
+    /// The time step of a run, which its check approves and its problem takes; `None` for a
+    /// benchmark that does not step in time.
+    pub time_step: Option<TimeStepFn>,
 }
+
+/// How a simulation benchmark's runs step (`BenchmarkInfo::time_step`).
+pub type TimeStepFn = fn(&Params) -> Result<TimeStep, ParamError>;
 
 const CATALOG: &[BenchmarkInfo] = &[
     mms_gong::INFO_1D,

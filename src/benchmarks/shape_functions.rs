@@ -4,6 +4,7 @@
 
 use nalgebra::SVector;
 
+use super::limits::{check_count, largest, per_axis_total, power};
 use super::{BenchmarkInfo, BenchmarkKind, Domain, ParamDefault, ParamKind, ParamSpec};
 use crate::params::{get_f64, get_usize, ParamError, Params};
 use crate::shape::{LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
@@ -55,6 +56,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
                   points, with its consistency errors",
     params: PARAMS,
     check,
+    time_step: None,
 };
 
 pub(super) fn kind(name: &str) -> Option<BenchmarkKind> {
@@ -104,8 +106,9 @@ impl ShapeProblem {
     }
 }
 
-/// `dim` is 1 or 2, and gamma and tolerance give an LME basis in that dimension (checked
-/// whatever the method, so that an axis of gamma means the same for every run).
+/// `dim` is 1 or 2, gamma and tolerance give an LME basis in that dimension (checked
+/// whatever the method, so that an axis of gamma means the same for every run), and the
+/// lattice has at most `MAX_POINTS` points.
 fn check(params: &Params) -> Result<(), ParamError> {
     let dim = get_usize(params, "dim")?;
     let (gamma, tolerance) = (get_f64(params, "gamma")?, get_f64(params, "tolerance")?);
@@ -127,7 +130,21 @@ fn check(params: &Params) -> Result<(), ParamError> {
             "tolerance"
         };
         ParamError::new(key, e.to_string())
-    })
+    })?;
+    // The lattice holds the grid's nodes among its points, which bounds them too.
+    let (cells, points) = (get_usize(params, "cells")?, get_usize(params, "points")?);
+    check_count(
+        cells
+            .checked_mul(points)
+            .and_then(|n| n.checked_add(1))
+            .and_then(|n| per_axis_total(n, dim)),
+        "evaluation points",
+        &format!(
+            "(cells points + 1){} with cells = {cells} and points = {points}",
+            power(dim)
+        ),
+        largest(&[("cells", cells), ("points", points)]),
+    )
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::TimeStep;
 use super::{Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec, Problem};
 use crate::material::{Material, NeoHookean};
 
@@ -51,9 +52,8 @@ pub struct SineMmsSpec {
     pub material: NeoHookean,
     pub cells: usize,
     pub ppc: usize,
-    /// The time step asked for; `fit_time_step` shortens it so that t_end is hit.
-    pub dt_max: f64,
-    pub t_end: f64,
+    /// The benchmark's time step, the one its check approved.
+    pub step: TimeStep,
 }
 
 /// The manufactured problem in `D` dimensions.
@@ -88,24 +88,9 @@ struct AxisTable {
     inv_f2: Vec<f64>,
 }
 
-/// The largest step not above `dt_max` that divides `t_end` into a whole number of steps.
-/// The ratio is rounded first so that t_end/dt_max = 40.000000000000004 does not add a step.
-pub fn fit_time_step(dt_max: f64, t_end: f64) -> (f64, usize) {
-    let ratio = t_end / dt_max;
-    let nearest = ratio.round();
-    let steps = if (ratio - nearest).abs() <= 1e-9 * nearest {
-        nearest
-    } else {
-        ratio.ceil()
-    };
-    let steps = (steps as usize).max(1);
-    (t_end / steps as f64, steps)
-}
-
 impl<const D: usize> SineMms<D> {
     pub fn new(spec: &SineMmsSpec) -> Self {
         let wave = spec.wave;
-        let (dt, steps) = fit_time_step(spec.dt_max, spec.t_end);
         SineMms {
             amplitude: wave.amplitude,
             wavenumber: wave.wavenumber,
@@ -116,8 +101,8 @@ impl<const D: usize> SineMms<D> {
             material: spec.material,
             cells: spec.cells,
             ppc: spec.ppc,
-            dt,
-            steps,
+            dt: spec.step.dt,
+            steps: spec.step.steps,
             axes: std::array::from_fn(|_| AxisTable::default()),
             axis_index: Vec::new(),
         }
@@ -351,8 +336,10 @@ pub(super) mod tests {
             material: NeoHookean { lambda, mu },
             cells: 8,
             ppc: 2,
-            dt_max: 1e-3,
-            t_end: 0.02,
+            step: TimeStep {
+                dt: 1e-3,
+                steps: 20,
+            },
         })
     }
 
@@ -381,18 +368,5 @@ pub(super) mod tests {
     fn material_point_inverts_the_motion() {
         check_inverse_motion::<1>();
         check_inverse_motion::<2>();
-    }
-
-    #[test]
-    fn time_step_is_kept_when_it_divides_t_end() {
-        assert_eq!(fit_time_step(1e-5, 0.02).1, 2000);
-        assert_eq!(fit_time_step(5e-4, 0.02), (5e-4, 40));
-    }
-
-    #[test]
-    fn time_step_is_shortened_to_hit_t_end() {
-        let (dt, steps) = fit_time_step(3e-3, 0.02);
-        assert_eq!(steps, 7);
-        assert!((dt * 7.0 - 0.02).abs() < 1e-18);
     }
 }

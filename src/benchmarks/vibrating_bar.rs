@@ -8,9 +8,9 @@ use std::f64::consts::PI;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::sine_mms::fit_time_step;
+use super::limits::{check_lattice, given_time_step};
 use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
-use super::{ParamError, Params, Problem};
+use super::{ParamError, Params, Problem, TimeStep};
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_str, get_usize};
 
@@ -90,11 +90,13 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     description: "linear-elastic bar on [0,H], fixed ends, sine initial velocity",
     params: PARAMS,
     check: check_params,
+    time_step: Some(time_step),
 };
 
-/// Explicit stability with the undeformed wave speed, and an exact solution that keeps the
-/// density finite.
+/// The size of the run, explicit stability with the undeformed wave speed, and an exact
+/// solution that keeps the density finite.
 fn check_params(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, 1, "particles")?;
     let bar = VibratingBar::new(params)?;
     let h = bar.length / bar.cells as f64;
     let c = bar.wave_speed();
@@ -140,7 +142,7 @@ pub struct VibratingBar {
 
 impl VibratingBar {
     fn new(params: &Params) -> Result<Self, ParamError> {
-        let (dt, steps) = fit_time_step(get_f64(params, "dt")?, get_f64(params, "t_end")?);
+        let TimeStep { dt, steps } = time_step(params)?;
         Ok(VibratingBar {
             length: get_f64(params, "H")?,
             rho0: get_f64(params, "rho0")?,
@@ -157,6 +159,11 @@ impl VibratingBar {
     fn wave_speed(&self) -> f64 {
         (self.young / self.rho0).sqrt()
     }
+}
+
+/// The given dt, fitted to t_end.
+fn time_step(params: &Params) -> Result<TimeStep, ParamError> {
+    given_time_step(params, PARAMS)
 }
 
 /// Builds the bar from validated parameters.

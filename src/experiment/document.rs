@@ -104,14 +104,17 @@ pub(crate) fn benchmark(sections: &Sections) -> Result<Benchmark, ConfigError> {
 }
 
 /// `output: {every: N}`; without it only the first and last states are stored (`every = 0`).
-pub(crate) fn output(sections: &Sections) -> Result<OutputSpec, ConfigError> {
+/// Also where `every` is written (the document start without it), for errors about the
+/// samples it makes.
+pub(crate) fn output(sections: &Sections) -> Result<(OutputSpec, Pos), ConfigError> {
+    let unsampled = (OutputSpec { every: 0 }, sections.pos);
     let Some(section) = sections.get("output") else {
-        return Ok(OutputSpec { every: 0 });
+        return Ok(unsampled);
     };
     let entries = section.value.entries("output")?;
     reject_unknown_keys(&entries, &["every"], "output")?;
     let Some(every) = find(&entries, "every") else {
-        return Ok(OutputSpec { every: 0 });
+        return Ok(unsampled);
     };
     let field = "output.every";
     let node = every.value;
@@ -130,5 +133,5 @@ pub(crate) fn output(sections: &Sections) -> Result<OutputSpec, ConfigError> {
     let every = positive_int(node, field)?;
     let every = usize::try_from(every)
         .map_err(|_| node.expected(field, "an interval that fits in this machine's usize"))?;
-    Ok(OutputSpec { every })
+    Ok((OutputSpec { every }, node.pos))
 }

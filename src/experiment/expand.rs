@@ -10,7 +10,7 @@ use crate::params::{ParamError, ParamValue, Params};
 use crate::reference;
 
 use super::document::Benchmark;
-use super::error::ConfigError;
+use super::error::{ConfigError, Pos};
 use super::run_id::{config_body, config_yaml, run_id};
 use super::space::{Block, ParamSpace, Written};
 use super::values::{method_names, METHOD_KEY};
@@ -24,11 +24,21 @@ const GAUSS_PLACEMENT: &str = "gauss";
 /// More runs than this is taken to be a mistake in the matrix, not a plan.
 pub const MAX_RUNS: usize = 100_000;
 
+/// Most history samples a run may store (t = 0, every `output.every`-th step and the final
+/// time): a thousand times the most a committed study stores (104).
+pub const MAX_SAMPLES: usize = 100_000;
+
+/// How the runs' histories are sampled: `output.every` and where it is written.
+pub(crate) struct Sampling {
+    pub every: usize,
+    pub pos: Pos,
+}
+
 pub(crate) fn expand(
     experiment: &str,
     benchmark: &Benchmark,
     space: &ParamSpace,
-    output_every: usize,
+    sampling: &Sampling,
 ) -> Result<Vec<RunSpec>, ConfigError> {
     run_count(space)?;
     let defaults = benchmarks::default_params(benchmark.info.params);
@@ -38,7 +48,7 @@ pub(crate) fn expand(
     for (b, block) in space.blocks.iter().enumerate() {
         for index in 0..block_size(block) {
             let chosen = choose(space, block, index);
-            let run = resolve(experiment, benchmark, &defaults, &chosen, output_every)?;
+            let run = resolve(experiment, benchmark, &defaults, &chosen, sampling)?;
             if let Some(earlier) = made_by.insert(run.run_id.clone(), b) {
                 return Err(ConfigError::at(
                     block.pos,
@@ -131,7 +141,7 @@ fn resolve(
     benchmark: &Benchmark,
     defaults: &Params,
     chosen: &[Chosen],
-    output_every: usize,
+    sampling: &Sampling,
 ) -> Result<RunSpec, ConfigError> {
     let mut params = defaults.clone();
     let mut method = String::new();
@@ -166,6 +176,11 @@ fn resolve(
         check_method_params(&method, benchmark, &params)
             .map_err(|e| check_error(e, benchmark, &params, chosen))?;
     }
+    if let Some(time_step) = benchmark.info.time_step {
+        let step = time_step(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
+        check_samples(step.steps, sampling, chosen)?;
+    }
+    let output_every = sampling.every;
     let body = config_body(benchmark.info.name, &method, output_every, &params);
     Ok(RunSpec {
         experiment: experiment.to_string(),
@@ -220,6 +235,44 @@ fn placement_conflict(method: &str, params: &Params) -> Option<ParamError> {
     })
 }
 
+/// A run samples its history at t = 0, every `every`-th step and the final time (every = 0:
+/// the first and last states only); at most `MAX_SAMPLES` times.
+fn check_samples(steps: usize, sampling: &Sampling, chosen: &[Chosen]) -> Result<(), ConfigError> {
+    let every = sampling.every;
+    if every == 0 {
+        return Ok(());
+    }
+    let samples = 1 + steps / every + usize::from(!steps.is_multiple_of(every));
+    if samples <= MAX_SAMPLES {
+        return Ok(());
+    }
+    Err(ConfigError::at(
+        sampling.pos,
+        "output.every",
+        format!(
+            "every = {every} stores {samples} samples of the {steps} steps of a run (t = 0, \
+             every {every} steps and t_end); at most {MAX_SAMPLES} are stored: use every >= \
+             {}{}",
+            steps.div_ceil(MAX_SAMPLES - 2),
+            in_run(chosen)
+        ),
+    ))
+}
+
+/// " (in the run with k=v, ...)" over the axis values of a run; nothing without axes.
+fn in_run(chosen: &[Chosen]) -> String {
+    let run: Vec<String> = chosen
+        .iter()
+        .filter(|c| c.is_axis)
+        .map(|c| format!("{}={}", c.key, c.written.value))
+        .collect();
+    if run.is_empty() {
+        String::new()
+    } else {
+        format!(" (in the run with {})", run.join(", "))
+    }
+}
+
 /// Places a failed benchmark check at the value it names: the matrix element or params entry
 /// it came from, or the benchmark key for a default; and says which run it was.
 fn check_error(
@@ -228,16 +281,7 @@ fn check_error(
     params: &Params,
     chosen: &[Chosen],
 ) -> ConfigError {
-    let run: Vec<String> = chosen
-        .iter()
-        .filter(|c| c.is_axis)
-        .map(|c| format!("{}={}", c.key, c.written.value))
-        .collect();
-    let in_run = if run.is_empty() {
-        String::new()
-    } else {
-        format!(" (in the run with {})", run.join(", "))
-    };
+    let in_run = in_run(chosen);
     match chosen.iter().find(|c| c.key == error.key) {
         Some(Chosen { written, .. }) => ConfigError::at(
             written.pos,
@@ -264,7 +308,6 @@ fn check_error(
 mod tests {
     use super::*;
     use crate::benchmarks::{BenchmarkInfo, ParamDefault, ParamKind, ParamSpec};
-    use crate::experiment::error::Pos;
     use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
     use crate::params::ParamValue;
@@ -292,6 +335,7 @@ mod tests {
             },
         ],
         check: reject_three,
+        time_step: None,
     };
 
     fn reject_three(params: &Params) -> Result<(), ParamError> {
@@ -306,6 +350,13 @@ mod tests {
             value,
             pos: Pos { line, column: 5 },
             field: field.to_string(),
+        }
+    }
+
+    fn sampling(every: usize) -> Sampling {
+        Sampling {
+            every,
+            pos: Pos::START,
         }
     }
 
@@ -341,7 +392,7 @@ mod tests {
                 column: 12,
             },
         };
-        let e = expand("toy_exp", &benchmark, &toy_space(), 0).unwrap_err();
+        let e = expand("toy_exp", &benchmark, &toy_space(), &sampling(0)).unwrap_err();
         assert_eq!((e.line, e.column, e.field.as_str()), (2, 12, "params.k"));
         assert!(e.message.contains("the default k = 3 of toy"), "{e}");
         assert!(e.message.ends_with("(in the run with x=1.0)"), "{e}");
@@ -357,7 +408,7 @@ mod tests {
         space
             .fixed
             .push(("k".into(), written(ParamValue::Int(4), 3, "params.k")));
-        let runs = expand("toy_exp", &benchmark, &space, 7).unwrap();
+        let runs = expand("toy_exp", &benchmark, &space, &sampling(7)).unwrap();
         assert_eq!(runs.len(), 2);
         assert_eq!(runs[1].params["x"], ParamValue::Float(2.0));
         assert_eq!(runs[1].params["k"], ParamValue::Int(4));

@@ -26,8 +26,9 @@ use crate::output::Measures;
 use crate::params::Params;
 
 pub use error::ConfigError;
-pub use expand::MAX_RUNS;
+pub use expand::{MAX_RUNS, MAX_SAMPLES};
 pub use select::{Allowed, Selection};
+pub use values::MAX_LIST_VALUES;
 
 use document::Sections;
 use error::{Pos, FILE_FIELD};
@@ -55,14 +56,18 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let benchmark = document::benchmark(&sections)?;
     let kind = benchmarks::kind(benchmark.info);
     let space = ParamSpace::read(&sections, benchmark.info)?;
-    let output = document::output(&sections)?;
+    let (output, every_pos) = document::output(&sections)?;
     let reference = reference::read(sections.get("reference"), &space, benchmark.info, kind)?;
     let measures = Measures::of_benchmark(benchmark.info).with_reference(reference.is_some());
     let expect = expect::read(sections.get("expect"), &space, measures)?;
     let figures = figures::read(sections.get("figures"), &space, kind, measures)?;
     let tables = tables::read(sections.get("tables"), &space, kind, measures)?;
     let paper_claims = claims::read(sections.get("paper_claims"), &space, measures, &figures)?;
-    let runs = expand::expand(&name, &benchmark, &space, output.every)?;
+    let sampling = expand::Sampling {
+        every: output.every,
+        pos: every_pos,
+    };
+    let runs = expand::expand(&name, &benchmark, &space, &sampling)?;
     if let (Some(select), Some(section)) = (&reference, sections.get("reference")) {
         reference::check_unique(select, &runs, section)?;
     }

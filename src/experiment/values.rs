@@ -11,6 +11,10 @@ use super::yaml::{child_field, item_field, Entry, Node, NodeKind};
 /// The key that selects the method; settable like a benchmark parameter.
 pub(crate) const METHOD_KEY: &str = "method";
 
+/// Most numbers a list parameter (the `points` of a reconstruction) may hold: 100,000 points
+/// is far more than a reconstruction study needs, and well within what the YAML reader takes.
+pub const MAX_LIST_VALUES: usize = 100_000;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum ValueKind {
     Param(ParamKind),
@@ -49,12 +53,12 @@ pub(crate) fn settable_kind(
     if entry.key == METHOD_KEY {
         return Ok(ValueKind::Method(benchmarks::kind(info)));
     }
-    let method_params = if benchmarks::kind(info).steps() {
-        methods::METHOD_PARAMS
+    let (method_params, limits) = if benchmarks::kind(info).steps() {
+        (methods::METHOD_PARAMS, benchmarks::LIMIT_PARAMS)
     } else {
-        &[]
+        (&[][..], &[][..])
     };
-    let settable = || info.params.iter().chain(method_params);
+    let settable = || info.params.iter().chain(method_params).chain(limits);
     match settable().find(|p| p.key == entry.key) {
         Some(p) => Ok(ValueKind::Param(p.kind)),
         None => {
@@ -88,10 +92,19 @@ pub(crate) fn normalize(
     }
 }
 
-/// A non-empty list of finite numbers; a bad element is reported at its own position.
+/// A non-empty list of at most `MAX_LIST_VALUES` finite numbers; a bad element is reported at
+/// its own position.
 fn real_list(node: &Node, field: &str) -> Result<Vec<f64>, ConfigError> {
     const EXPECTED: &str = "a non-empty list of finite numbers";
     match &node.kind {
+        NodeKind::List(items) if items.len() > MAX_LIST_VALUES => Err(ConfigError::at(
+            node.pos,
+            field,
+            format!(
+                "the list holds {} numbers; at most {MAX_LIST_VALUES} are accepted",
+                items.len()
+            ),
+        )),
         NodeKind::List(items) if !items.is_empty() => items
             .iter()
             .enumerate()

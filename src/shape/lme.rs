@@ -28,6 +28,12 @@ pub const MAX_ITERATIONS: usize = 100;
 /// Newton stops when |r| < RESIDUAL_TOLERANCE h, i.e. when sum_a p_a x_a reproduces x to that.
 pub const RESIDUAL_TOLERANCE: f64 = 1e-12;
 
+/// Most nodes in the stencil block of one point. Every particle holds its block's nodes,
+/// weights and gradients, so this bounds the memory of the basis: 1024 (32 x 32 in 2D) takes
+/// gamma down to 0.054 in 2D and 5.3e-5 in 1D at the default tolerance, where the committed
+/// studies need at most 196 (gamma 0.3 in 2D).
+pub const MAX_STENCIL_NODES: usize = 1024;
+
 /// Sufficient-decrease factor of the Armijo test on log Z.
 const ARMIJO: f64 = 1e-4;
 
@@ -70,16 +76,34 @@ pub struct LocalMaxEnt<const D: usize> {
     failures: AtomicUsize,
 }
 
-/// gamma and tolerance for which the LME problem has no solution at some point of the grid.
+/// gamma and tolerance for which the LME problem has no solution at some point of the grid, or
+/// whose stencil is larger than `MAX_STENCIL_NODES`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LmeParamError {
     pub gamma: f64,
     pub tolerance: f64,
     pub dimension: usize,
+    /// The nodes per point of the stencil when its size is what is refused.
+    pub stencil_nodes: Option<f64>,
 }
 
 impl fmt::Display for LmeParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(nodes) = self.stencil_nodes {
+            // floor(2 r) + 1 <= n nodes per axis holds exactly when r < n / 2.
+            let per_axis = largest_block_side(self.dimension) as f64;
+            let gamma_min = -self.tolerance.ln() / (0.25 * per_axis * per_axis);
+            return write!(
+                f,
+                "gamma = {:?} with tolerance = {:?} gives the cut-off radius {:.4e} h and a \
+                 stencil of {nodes:.4e} nodes per point in {}D; at most {MAX_STENCIL_NODES} \
+                 are supported, which needs gamma > {gamma_min:.4e} at this tolerance",
+                self.gamma,
+                self.tolerance,
+                cut_off_radius(self.gamma, self.tolerance),
+                self.dimension
+            );
+        }
         write!(
             f,
             "LME needs gamma > 0, 0 < tolerance < 1 and, in {}D, a cut-off radius \
@@ -109,6 +133,27 @@ fn cut_off_radius(gamma: f64, tolerance: f64) -> f64 {
     (-tolerance.ln() / gamma).sqrt()
 }
 
+/// Nodes per axis of the stencil block of a cut-off radius (in units of h): those from x - r
+/// to x + r. A real, so that an overlong radius does not overflow.
+fn block_side(radius: f64) -> f64 {
+    (2.0 * radius).floor() + 1.0
+}
+
+/// The most nodes per axis of a stencil block within `MAX_STENCIL_NODES` in `dimension`
+/// dimensions.
+fn largest_block_side(dimension: usize) -> usize {
+    let fits = |side: usize| {
+        u32::try_from(dimension)
+            .ok()
+            .and_then(|d| side.checked_pow(d))
+            .is_some_and(|nodes| nodes <= MAX_STENCIL_NODES)
+    };
+    (1..=MAX_STENCIL_NODES)
+        .take_while(|&side| fits(side))
+        .last()
+        .unwrap_or(1)
+}
+
 /// The smallest cut-off radius (in units of h) for which every point strictly inside the grid
 /// lies strictly inside the convex hull of its selected nodes: a point just off a cell face,
 /// midway along it, needs the nodes of the next layer, sqrt(1 + (D - 1) / 4) away.
@@ -132,17 +177,25 @@ impl<const D: usize> LocalMaxEnt<D> {
             && tolerance < 1.0
             && radius.is_finite()
             && radius > surround_radius(D);
+        let error = |stencil_nodes| LmeParamError {
+            gamma,
+            tolerance,
+            dimension: D,
+            stencil_nodes,
+        };
         if !valid {
-            return Err(LmeParamError {
-                gamma,
-                tolerance,
-                dimension: D,
-            });
+            return Err(error(None));
+        }
+        let side = block_side(radius);
+        let nodes = side.powi(D as i32);
+        if nodes > MAX_STENCIL_NODES as f64 {
+            return Err(error(Some(nodes)));
         }
         Ok(LocalMaxEnt {
             gamma,
             radius,
-            per_axis: (2.0 * radius).floor() as usize + 1,
+            // At most MAX_STENCIL_NODES, so the cast is exact.
+            per_axis: side as usize,
             max_step: 2.0 * gamma * radius,
             max_iterations: MAX_ITERATIONS,
             failures: AtomicUsize::new(0),

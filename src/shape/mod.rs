@@ -17,7 +17,8 @@ pub use dual_domain::{DualDomain, DualIntegrals};
 pub use grid::{lattice_coords, lattice_strides, Dofs, Grid};
 pub use linear::LinearHat;
 pub use lme::{
-    LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, RESIDUAL_TOLERANCE,
+    LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, MAX_STENCIL_NODES,
+    RESIDUAL_TOLERANCE,
 };
 pub use stencils::Stencils;
 

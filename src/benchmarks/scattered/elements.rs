@@ -8,6 +8,7 @@ use super::functions::{ElementFunction, SurfaceFunction, TestFunction};
 use super::points::{cell_fractions, check_ppc, Spacing};
 use super::ParamSpec;
 use super::{choice, interval, BenchmarkInfo, Domain, ParamDefault, ParamKind};
+use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
 use crate::params::{get_usize, ParamError, Params};
 use crate::rng::Lcg;
 use crate::shape::lattice_coords;
@@ -84,6 +85,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
                   RMS and integral errors at Gauss points",
     params: PARAMS,
     check,
+    time_step: None,
 };
 
 /// One element-wise reconstruction problem in `D` dimensions, resolved from parameters.
@@ -243,7 +245,24 @@ fn check(params: &Params) -> Result<(), ParamError> {
             format!("gauss = {gauss}: at most {MAX_GAUSS_POINTS} Gauss points per axis"),
         ));
     }
-    Ok(())
+    let cells = get_usize(params, "cells")?;
+    let [ppc, ppc_y] = layout.per_axis;
+    let elements = per_axis_total(cells, dim);
+    let p = power(dim);
+    check_count(
+        elements.and_then(|n| n.checked_mul(ppc)?.checked_mul(ppc_y)),
+        "data points",
+        &format!("cells{p} ppc ppc_y with cells = {cells}, ppc = {ppc} and ppc_y = {ppc_y}"),
+        largest(&[("cells", cells), ("ppc", ppc), ("ppc_y", ppc_y)]),
+    )?;
+    check_count(
+        cells
+            .checked_mul(gauss)
+            .and_then(|n| per_axis_total(n, dim)),
+        "Gauss points",
+        &format!("(cells gauss){p} with cells = {cells} and gauss = {gauss}"),
+        largest(&[("cells", cells), ("gauss", gauss)]),
+    )
 }
 
 #[cfg(test)]

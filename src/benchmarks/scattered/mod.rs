@@ -12,12 +12,13 @@ mod elements;
 mod functions;
 mod points;
 
-pub use elements::{ElementData, ElementProblem, INFO as INFO_ELEMENTS};
+pub use elements::{ElementData, ElementProblem, INFO as INFO_ELEMENTS, MAX_GAUSS_POINTS};
 pub use functions::{ElementFunction, ExactField, SurfaceFunction, TestFunction};
 pub use points::{place, Spacing};
 
 use points::check_ppc;
 
+use super::limits::{check_count, check_lattice};
 use super::{BenchmarkInfo, BenchmarkKind, Domain, ParamDefault, ParamKind, ParamSpec};
 use crate::params::{get_f64, get_list, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{Weight, MAX_NODE_SUPPORT_CELLS};
@@ -126,6 +127,7 @@ pub const INFO_NODES: BenchmarkInfo = BenchmarkInfo {
     description: "u sampled at equal or random points per cell, reconstructed at the grid nodes",
     params: NODE_PARAMS,
     check: check_nodes,
+    time_step: None,
 };
 
 pub const INFO_BASIS: BenchmarkInfo = BenchmarkInfo {
@@ -135,6 +137,7 @@ pub const INFO_BASIS: BenchmarkInfo = BenchmarkInfo {
     description: "weighted orthogonal polynomials of given points, and u reconstructed from them",
     params: BASIS_PARAMS,
     check: check_basis,
+    time_step: None,
 };
 
 pub(super) fn kind(name: &str) -> Option<BenchmarkKind> {
@@ -214,8 +217,9 @@ fn interval(params: &Params) -> Result<(f64, f64), ParamError> {
     }
 }
 
-/// As `check_support`, and a placement has the points it needs per cell.
+/// The size of the run, as `check_support`, and a placement has the points it needs per cell.
 fn check_nodes(params: &Params) -> Result<(), ParamError> {
+    check_lattice(params, 1, "data points")?;
     check_support(params)?;
     let spacing = choice(params, "spacing", Spacing::from_name)?;
     check_ppc(spacing, get_usize(params, "ppc")?)
@@ -239,8 +243,15 @@ fn check_support(params: &Params) -> Result<(), ParamError> {
     Ok(())
 }
 
-/// As `check_support`, and the points and the centre lie in the interval.
+/// The grid's size, as `check_support`, and the points and the centre lie in the interval.
 fn check_basis(params: &Params) -> Result<(), ParamError> {
+    let cells = get_usize(params, "cells")?;
+    check_count(
+        cells.checked_add(1),
+        "grid nodes",
+        &format!("cells + 1 with cells = {cells}"),
+        "cells",
+    )?;
     check_support(params)?;
     let (lower, upper) = interval(params)?;
     let inside = |x: f64| (lower..=upper).contains(&x);

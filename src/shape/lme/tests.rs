@@ -300,3 +300,29 @@ fn lme_parameters_are_validated() {
     let radius = LocalMaxEnt::<2>::new(0.8).unwrap().radius();
     assert!((radius - 4.1556).abs() < 1e-4, "{radius}");
 }
+
+/// The stencil block is at most MAX_STENCIL_NODES nodes: gamma is bounded below at each
+/// tolerance, and the message gives the stencil and the smallest gamma it allows.
+#[test]
+fn stencils_are_bounded() {
+    // 2D, tolerance 1e-6: gamma > 4 (-ln 1e-6) / 32^2 = 0.05396.
+    assert!(LocalMaxEnt::<2>::new(0.054).is_ok());
+    let e = LocalMaxEnt::<2>::new(0.0539).unwrap_err();
+    assert_eq!(e.stencil_nodes, Some(33.0 * 33.0));
+    let text = e.to_string();
+    assert!(
+        text.contains("1.0890e3 nodes per point in 2D; at most 1024")
+            && text.contains("gamma > 5.3967e-2"),
+        "{text}"
+    );
+    // 1D: gamma = 1e-9 would take 235,079 nodes per point.
+    assert_eq!(
+        LocalMaxEnt::<1>::new(5.3e-5).unwrap().nodes_per_point(),
+        1022
+    );
+    let e = LocalMaxEnt::<1>::new(1e-9).unwrap_err();
+    assert_eq!(e.stencil_nodes, Some(235_079.0));
+    // A tiny tolerance widens the stencil as a tiny gamma does.
+    assert!(LocalMaxEnt::<1>::with_tolerance(1.0, 1e-300).is_ok());
+    assert!(LocalMaxEnt::<2>::with_tolerance(1.0, 1e-300).is_err());
+}
