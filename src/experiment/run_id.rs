@@ -29,15 +29,30 @@ pub(crate) fn config_yaml(experiment: &str, body: &str) -> String {
     format!("experiment: {experiment}\n{body}")
 }
 
+/// Longest run id. Its files' names add at most `.` and `.h5.tmp-<pid>` (16 bytes with a
+/// 32-bit process id), far below the 255 bytes a file name may have.
+pub const MAX_RUN_ID_LEN: usize = 120;
+
+/// A list value written longer than this enters the id as `list<length>`: its numbers are in
+/// the hash. The committed studies' lists are at most 42 characters long.
+const MAX_LIST_TEXT: usize = 48;
+
 /// `<method>-<axis><value>-...-<hash12>` over the non-method axes in file order; a list
-/// value is written with `_` between its numbers.
+/// value is written with `_` between its numbers (`list<length>` when that is longer than
+/// `MAX_LIST_TEXT`). Past `MAX_RUN_ID_LEN` the axis values are cut; the hash, of the whole
+/// configuration, still tells the runs apart.
 pub(crate) fn run_id(method: &str, axes: &[(&str, &ParamValue)], body: &str) -> String {
     let mut id = method.to_string();
     for (key, value) in axes {
         match value {
             ParamValue::List(values) => {
                 let items: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
-                let _ = write!(id, "-{key}{}", items.join("_"));
+                let text = items.join("_");
+                if text.len() > MAX_LIST_TEXT {
+                    let _ = write!(id, "-{key}list{}", values.len());
+                } else {
+                    let _ = write!(id, "-{key}{text}");
+                }
             }
             _ => {
                 let _ = write!(id, "-{key}{value}");
@@ -45,13 +60,17 @@ pub(crate) fn run_id(method: &str, axes: &[(&str, &ParamValue)], body: &str) -> 
         }
     }
     // The top 48 bits of the hash: 12 hex digits.
-    let _ = write!(id, "-{:012x}", fnv1a64(body.as_bytes()) >> 16);
-    id.chars()
+    let hash = format!("-{:012x}", fnv1a64(body.as_bytes()) >> 16);
+    // Every character becomes one ASCII byte, so the cut falls between characters.
+    let mut id: String = id
+        .chars()
         .map(|c| match c {
             'A'..='Z' | 'a'..='z' | '0'..='9' | '.' | '_' | '-' => c,
             _ => '_',
         })
-        .collect()
+        .collect();
+    id.truncate(MAX_RUN_ID_LEN - hash.len());
+    id + &hash
 }
 
 /// 64-bit FNV-1a.
@@ -95,5 +114,28 @@ mod tests {
         let id = run_id("mpm", &[("G", &g), ("tag", &tag), ("x", &points)], "body");
         let hash = format!("{:012x}", fnv1a64(b"body") >> 16);
         assert_eq!(id, format!("mpm-G0.1-taga_b_c-x-0.5_1.0-{hash}"));
+    }
+
+    #[test]
+    fn ids_are_bounded() {
+        let hash = format!("{:012x}", fnv1a64(b"body") >> 16);
+        // Short lists are written out, long ones by their length.
+        let short = ParamValue::List(vec![-0.6666666666666666, 0.0, 0.6666666666666666]);
+        let id = run_id("imls", &[("points", &short)], "body");
+        assert_eq!(
+            id,
+            format!("imls-points-0.6666666666666666_0.0_0.6666666666666666-{hash}")
+        );
+        let long = ParamValue::List((0..40).map(|i| f64::from(i) / 40.0).collect());
+        let g = ParamValue::Float(0.1);
+        let id = run_id("imls", &[("points", &long), ("G", &g)], "body");
+        assert_eq!(id, format!("imls-pointslist40-G0.1-{hash}"));
+        // Many axes are cut to the bound, the hash kept.
+        let keys: Vec<String> = (0..30).map(|i| format!("key{i}")).collect();
+        let axes: Vec<(&str, &ParamValue)> = keys.iter().map(|k| (k.as_str(), &g)).collect();
+        let id = run_id("mpm", &axes, "body");
+        assert_eq!(id.len(), MAX_RUN_ID_LEN);
+        assert!(id.starts_with("mpm-key00.1-key10.1-"), "{id}");
+        assert!(id.ends_with(&format!("-{hash}")), "{id}");
     }
 }
