@@ -35,12 +35,14 @@ use document::Sections;
 use error::{Pos, FILE_FIELD};
 use space::ParamSpace;
 
-/// Reads and validates an experiment file; an unreadable file is a `ConfigError` too.
+/// Reads and validates an experiment file; an unreadable file, or one that is not UTF-8
+/// text, is a `ConfigError` too.
 pub fn load(path: &Path) -> Result<Experiment, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let bytes = std::fs::read(path).map_err(|e| {
         ConfigError::at(Pos::START, FILE_FIELD, format!("cannot read the file: {e}")).in_file(path)
     })?;
-    parse(&text, path)
+    let text = yaml::decode(&bytes).map_err(|e| e.in_file(path))?;
+    parse(text, path)
 }
 
 /// Validates the text of an experiment file and expands its matrix; `path` names the file in

@@ -5,15 +5,19 @@
 use std::fmt;
 
 use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde_saphyr::budget::BudgetBreach;
 use serde_saphyr::options::NonFiniteFloatPolicy;
-use serde_saphyr::{DefaultMessageFormatter, Location, MessageFormatter, Spanned};
+use serde_saphyr::{Budget, Location, MessageFormatter, Spanned, Tagged, UserMessageFormatter};
 
-use super::error::{ConfigError, Pos, DOCUMENT_FIELD};
+use super::error::{ConfigError, Pos, DOCUMENT_FIELD, FILE_FIELD};
 
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Node {
     pub kind: NodeKind,
     pub pos: Pos,
+    /// An explicit YAML tag (`!foo`, `!!str`), which `parse_tree` refuses: a tag would change
+    /// how a value is read in ways no experiment needs.
+    tag: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -38,30 +42,181 @@ pub(crate) struct Entry<'a> {
     pub value: &'a Node,
 }
 
+/// The text of a file, which must be UTF-8; an error points at the first byte that is not.
+pub(crate) fn decode(bytes: &[u8]) -> Result<&str, ConfigError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let valid = &bytes[..e.valid_up_to()];
+        // The valid prefix decodes, by definition.
+        let before = std::str::from_utf8(valid).unwrap_or_default();
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let pos = Pos {
+            line: before.matches('\n').count() + 1,
+            column: before[line_start..].chars().count() + 1,
+        };
+        let field = key_on_line(before, pos.line).unwrap_or(FILE_FIELD);
+        ConfigError::at(
+            pos,
+            field,
+            format!(
+                "the byte 0x{:02x} is not UTF-8 text; experiment files are UTF-8",
+                bytes[e.valid_up_to()]
+            ),
+        )
+    })
+}
+
 /// Parses a whole file. Syntax errors carry the parser's position; their field is a guess.
 pub(crate) fn parse_tree(text: &str) -> Result<Node, ConfigError> {
+    let budget = Budget::default();
     let options = serde_saphyr::options! {
         // YAML 1.2 booleans, so that `n`, `no` or `on` stay text.
         strict_booleans: true,
         non_finite_float_policy: NonFiniteFloatPolicy::PassThrough,
         with_snippet: false,
+        budget: Some(budget.clone()),
     };
-    serde_saphyr::from_str_with_options(text, options).map_err(|e| syntax_error(&e, text))
+    let root: Node = serde_saphyr::from_str_with_options(text, options)
+        .map_err(|e| syntax_error(&e, text, &budget))?;
+    let Some((tag, node_pos)) = root.first_tag() else {
+        return Ok(root);
+    };
+    let (pos, tag) = written_tag(text, node_pos).unwrap_or((node_pos, tag));
+    // A tagged key is guessed with its tag in front.
+    let field = key_on_line(text, pos.line).map(|key| key.strip_prefix(tag).unwrap_or(key));
+    Err(ConfigError::at(
+        pos,
+        field.map_or(DOCUMENT_FIELD, str::trim_start),
+        format!("the YAML tag '{tag}' is not accepted; write the value without it"),
+    ))
 }
 
-fn syntax_error(err: &serde_saphyr::Error, text: &str) -> ConfigError {
+/// Where the tag of the node at `node` is written, and how: the token before the node's
+/// content, past blanks, line ends, comments and an anchor (`&name`). `None` when it is not
+/// found there (the parser names the node's content, after its tag).
+fn written_tag(text: &str, node: Pos) -> Option<(Pos, &str)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut line = node.line.checked_sub(1)?;
+    let source = lines.get(line)?;
+    let end = source
+        .char_indices()
+        .nth(node.column - 1)
+        .map_or(source.len(), |(i, _)| i);
+    let mut before = &source[..end];
+    loop {
+        let trimmed = before.trim_end();
+        if trimmed.is_empty() {
+            // The content starts a line: the tag ends an earlier one, before any comment.
+            line = line.checked_sub(1)?;
+            let earlier = lines[line];
+            before = match earlier.find(" #") {
+                Some(i) => &earlier[..i],
+                None if earlier.trim_start().starts_with('#') => "",
+                None => earlier,
+            };
+            continue;
+        }
+        let start = trimmed.rfind(char::is_whitespace).map_or(0, |i| i + 1);
+        // A flow collection's opening or separator may touch the token: `[!tag 1]`.
+        let token = trimmed[start..].trim_start_matches(['[', '{', ',']);
+        let token_start = trimmed.len() - token.len();
+        if token.starts_with('&') {
+            before = &trimmed[..token_start];
+        } else if token.starts_with('!') {
+            let column = trimmed[..token_start].chars().count() + 1;
+            return Some((
+                Pos {
+                    line: line + 1,
+                    column,
+                },
+                token,
+            ));
+        } else {
+            return None;
+        }
+    }
+}
+
+fn syntax_error(err: &serde_saphyr::Error, text: &str, budget: &Budget) -> ConfigError {
     let err = err.without_snippet();
     let pos = err.location().map_or(Pos::START, position);
-    if let serde_saphyr::Error::DuplicateMappingKey { key: Some(key), .. } = err {
-        return ConfigError::at(pos, key.as_str(), format!("duplicate key '{key}'"));
-    }
-    let message: String = DefaultMessageFormatter
-        .format_message(err)
+    let message = match err {
+        serde_saphyr::Error::DuplicateMappingKey { key: Some(key), .. } => {
+            return ConfigError::at(pos, key.as_str(), format!("duplicate key '{key}'"));
+        }
+        serde_saphyr::Error::MultipleDocuments { .. } => format!(
+            "a file holds one YAML document; found a second at line {}",
+            pos.line
+        ),
+        serde_saphyr::Error::Budget { breach, .. } => too_large(breach, budget),
+        serde_saphyr::Error::AliasReplayCounterOverflow { .. }
+        | serde_saphyr::Error::AliasReplayLimitExceeded { .. }
+        | serde_saphyr::Error::AliasExpansionLimitExceeded { .. }
+        | serde_saphyr::Error::AliasReplayStackDepthExceeded { .. } => {
+            "its aliases (*name) expand to more values than a file may hold".to_string()
+        }
+        serde_saphyr::Error::UnknownAnchor { .. } => {
+            "an alias (*name) names no anchor (&name) defined before it".to_string()
+        }
+        // The parser's own description of the syntax, in YAML's terms.
+        _ => UserMessageFormatter.format_message(err).into_owned(),
+    };
+    let message: String = message
         .chars()
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect();
     let field = key_on_line(text, pos.line).unwrap_or(DOCUMENT_FIELD);
     ConfigError::at(pos, field, format!("invalid YAML: {message}"))
+}
+
+/// What a breach of the reader's limits means, with the limit.
+fn too_large(breach: &BudgetBreach, budget: &Budget) -> String {
+    match breach {
+        BudgetBreach::Nodes { .. } => format!(
+            "the file has more than {} YAML nodes (values, lists and maps); at most that many \
+             are read",
+            budget.max_nodes
+        ),
+        BudgetBreach::Events { .. } => format!(
+            "the file has more than {} YAML events (nodes and the ends of lists and maps)",
+            budget.max_events
+        ),
+        BudgetBreach::Depth { .. } => format!(
+            "lists and maps are nested more than {} deep",
+            budget.max_depth
+        ),
+        BudgetBreach::Aliases { .. } => {
+            format!(
+                "the file has more than {} aliases (*name)",
+                budget.max_aliases
+            )
+        }
+        BudgetBreach::Anchors { .. } => {
+            format!(
+                "the file has more than {} anchors (&name)",
+                budget.max_anchors
+            )
+        }
+        BudgetBreach::AliasAnchorRatio { aliases, anchors } => format!(
+            "{aliases} aliases (*name) for {anchors} anchors (&name); at most {} per anchor",
+            budget.alias_anchor_ratio_multiplier
+        ),
+        BudgetBreach::Documents { .. } => format!(
+            "the file has more than {} YAML documents; it should hold one",
+            budget.max_documents
+        ),
+        BudgetBreach::ScalarBytes { .. } => format!(
+            "the values hold more than {} bytes of text",
+            budget.max_total_scalar_bytes
+        ),
+        BudgetBreach::MergeKeys { .. } => {
+            format!(
+                "the file has more than {} merge keys (<<)",
+                budget.max_merge_keys
+            )
+        }
+        BudgetBreach::SequenceUnbalanced => "a list or map ends that was never opened".to_string(),
+        _ => "the file is too large or too complex to read".to_string(),
+    }
 }
 
 /// The parser's 1-based location; an unknown one (0) becomes the start of the file, so that
@@ -87,6 +242,20 @@ fn key_on_line(text: &str, line: usize) -> Option<&str> {
 }
 
 impl Node {
+    /// The first explicit tag in the tree, in file order, and where it is.
+    fn first_tag(&self) -> Option<(&str, Pos)> {
+        if let Some(tag) = &self.tag {
+            return Some((tag, self.pos));
+        }
+        match &self.kind {
+            NodeKind::List(items) => items.iter().find_map(Node::first_tag),
+            NodeKind::Map(pairs) => pairs
+                .iter()
+                .find_map(|(key, value)| key.first_tag().or_else(|| value.first_tag())),
+            _ => None,
+        }
+    }
+
     /// What the node holds, for "expected X, found Y" messages.
     fn describe(&self) -> String {
         match &self.kind {
@@ -211,10 +380,12 @@ pub(crate) fn require<'e, 'a>(
 
 impl<'de> Deserialize<'de> for Node {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let spanned = Spanned::<NodeKind>::deserialize(deserializer)?;
+        let spanned = Spanned::<Tagged<NodeKind>>::deserialize(deserializer)?;
+        let Tagged(kind, tag) = spanned.value;
         Ok(Node {
-            kind: spanned.value,
+            kind,
             pos: position(spanned.referenced),
+            tag,
         })
     }
 }
