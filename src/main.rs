@@ -105,6 +105,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    end_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Expand { file, json } => expand(&file, json),
@@ -159,6 +160,18 @@ fn main() -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A reader that closes its end of the pipe (`mpmlab list-benchmarks | head -1`) ends the
+/// process quietly, as it ends other Unix tools, instead of making `println!` panic on the
+/// failed write: Rust's runtime ignores SIGPIPE, and this restores its default action.
+fn end_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in main, before any other thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
