@@ -6,7 +6,9 @@ use clap::{Parser, Subcommand};
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
 use mpmlab::output::{remove_dead_temps, write_atomically};
-use mpmlab::runner::{results_dir, run_experiment, RunOptions, EXPERIMENT_COPY};
+use mpmlab::runner::{
+    check_copy, check_distinct_names, results_dir, run_experiment, RunOptions, EXPERIMENT_COPY,
+};
 use mpmlab::shard::{Plan, Shard};
 use mpmlab::slurm;
 use mpmlab::{
@@ -185,6 +187,10 @@ fn load_all(files: &[PathBuf]) -> Result<Vec<Experiment>, String> {
 
 fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(), String> {
     let mut experiments = load_all(files)?;
+    check_distinct_names(&experiments)?;
+    for experiment in &experiments {
+        check_copy(&results_dir(&options.out, experiment), experiment)?;
+    }
     if let Some(shard) = shard {
         let plan = Plan::new(&experiments, shard.count);
         let load = plan.loads[shard.index - 1];
@@ -211,8 +217,12 @@ fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(
                 continue;
             }
         };
+        let elsewhere = match outcome.elsewhere {
+            0 => String::new(),
+            n => format!(", {n} computed by another process"),
+        };
         eprintln!(
-            "{}: {} runs written, {} already present, {} diverged, {} failed -> {}",
+            "{}: {} runs written, {} already present{elsewhere}, {} diverged, {} failed -> {}",
             experiment.name,
             outcome.written,
             outcome.skipped,
