@@ -67,7 +67,9 @@ def compare_experiment(a, b, problems, counts):
     if (a / "experiment.yaml").read_bytes() != (b / "experiment.yaml").read_bytes():
         problems.append(f"{name}: experiment.yaml differs")
     for d in (a, b):
-        leftovers = [p.name for p in (d / "runs").glob(".*")]
+        # Hidden files but the record of the experiment file (`runner::check_copy`) are what
+        # a write or a lock left behind.
+        leftovers = [p.name for p in (d / "runs").glob(".*") if p.name != ".experiment-source"]
         if leftovers:
             problems.append(f"{d}: temporary files left: {leftovers}")
     for run in common_runs_files(a, b, "*.h5", "run files", problems):

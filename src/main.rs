@@ -5,8 +5,10 @@ use clap::{Parser, Subcommand};
 
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
-use mpmlab::output::write_atomically;
-use mpmlab::runner::{results_dir, run_experiment, RunOptions, EXPERIMENT_COPY};
+use mpmlab::output::{remove_dead_temps, write_atomically};
+use mpmlab::runner::{
+    check_copy, check_distinct_names, results_dir, run_experiment, RunOptions, EXPERIMENT_COPY,
+};
 use mpmlab::shard::{Plan, Shard};
 use mpmlab::slurm;
 use mpmlab::{
@@ -198,6 +200,10 @@ fn load_all(files: &[PathBuf]) -> Result<Vec<Experiment>, String> {
 
 fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(), String> {
     let mut experiments = load_all(files)?;
+    check_distinct_names(&experiments)?;
+    for experiment in &experiments {
+        check_copy(&results_dir(&options.out, experiment), experiment)?;
+    }
     if let Some(shard) = shard {
         let plan = Plan::new(&experiments, shard.count);
         let load = plan.loads[shard.index - 1];
@@ -224,8 +230,12 @@ fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(
                 continue;
             }
         };
+        let elsewhere = match outcome.elsewhere {
+            0 => String::new(),
+            n => format!(", {n} computed by another process"),
+        };
         eprintln!(
-            "{}: {} runs written, {} already present, {} diverged, {} failed -> {}",
+            "{}: {} runs written, {} already present{elsewhere}, {} diverged, {} failed -> {}",
             experiment.name,
             outcome.written,
             outcome.skipped,
@@ -261,6 +271,19 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
             collected.runs.len()
         );
     }
+    for file in &collected.unreadable {
+        eprintln!(
+            "unreadable run file: {}: {}",
+            dir.join(&file.file).display(),
+            file.reason
+        );
+    }
+    if !collected.unreadable.is_empty() {
+        eprintln!(
+            "{} run file(s) unreadable (listed above); the report leaves them out",
+            collected.unreadable.len()
+        );
+    }
     let rates = report::fit_rates(&collected.experiment, &collected.runs);
     // The expectations are evaluated and written into report.md either way, so the report is
     // the same file with or without --check; --check only makes a failure the exit status.
@@ -269,6 +292,7 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
         dir,
         &collected.experiment,
         &collected.runs,
+        &collected.unreadable,
         &rates,
         Some(&failures),
     )
@@ -277,23 +301,41 @@ fn report_dir(dir: &Path, check: bool) -> Result<(), String> {
     if !check {
         return Ok(());
     }
+    let mut problems = Vec::new();
     if !failures.is_empty() {
         for failure in &failures {
             eprintln!("check failed: {}", failure.message);
         }
-        return Err(format!("{} expectation(s) not met", failures.len()));
+        problems.push(format!("{} expectation(s) not met", failures.len()));
+    }
+    if !collected.unreadable.is_empty() {
+        let files: Vec<String> = collected
+            .unreadable
+            .iter()
+            .map(|f| dir.join(&f.file).display().to_string())
+            .collect();
+        problems.push(format!(
+            "{} run file(s) unreadable: {}",
+            files.len(),
+            files.join(", ")
+        ));
     }
     if !collected.missing.is_empty() {
-        return Err(format!(
+        problems.push(format!(
             "{} run(s) of the matrix are missing",
             collected.missing.len()
         ));
+    }
+    if !problems.is_empty() {
+        return Err(problems.join("; "));
     }
     eprintln!("all expectations met");
     Ok(())
 }
 
-/// The index over every results directory under `root` (those with an experiment copy).
+/// The index over every results directory under `root` (those with an experiment copy). A
+/// directory that cannot be read or reported is listed in the index with the reason, and
+/// fails the command once the index of the others is written.
 fn index(root: &Path) -> Result<(), String> {
     let read = std::fs::read_dir(root).map_err(|e| format!("{}: {e}", root.display()))?;
     let mut dirs: Vec<String> = read
@@ -302,32 +344,56 @@ fn index(root: &Path) -> Result<(), String> {
         .map(|entry| entry.file_name().to_string_lossy().into_owned())
         .collect();
     dirs.sort();
-    let collected: Vec<Collected> = dirs
-        .iter()
-        .map(|dir| collect(&root.join(dir)))
-        .collect::<Result<_, _>>()?;
-    let rates: Vec<Vec<report::RateRow>> = collected
-        .iter()
-        .map(|c| report::fit_rates(&c.experiment, &c.runs))
+    let collected: Vec<(String, Result<Collected, String>)> = dirs
+        .into_iter()
+        .map(|dir| {
+            let collected = collect(&root.join(&dir));
+            (dir, collected)
+        })
         .collect();
     let mut indexed = Vec::new();
-    for ((dir, c), rates) in dirs.iter().zip(&collected).zip(&rates) {
-        let figures = report::figures::plan(&c.experiment, &c.runs)?;
-        let maps = report::figures::plan_maps(&c.experiment, &c.runs, &figures)?;
-        indexed.push(report::index::Indexed {
-            dir,
-            experiment: &c.experiment,
-            claims: report::claims::evaluate(&c.experiment, rates, &c.runs),
-            figures,
-            maps,
+    let mut unreadable = Vec::new();
+    for (dir, collected) in &collected {
+        let entry = collected.as_ref().map_err(Clone::clone).and_then(|c| {
+            index_entry(dir, c).map_err(|e| format!("{}: {e}", root.join(dir).display()))
         });
+        match entry {
+            Ok(entry) => indexed.push(entry),
+            Err(reason) => {
+                eprintln!("error: {reason}");
+                unreadable.push(report::index::Unreadable { dir, reason });
+            }
+        }
     }
+    remove_dead_temps(root).map_err(|e| format!("{}: {e}", root.display()))?;
     let path = root.join("README.md");
-    let md = report::index::index_md(&indexed);
+    let md = report::index::index_md(&indexed, &unreadable);
     write_atomically(&path, |tmp| std::fs::write(tmp, &md))
         .map_err(|e| format!("{}: {e}", path.display()))?;
     eprintln!("index written to {}", path.display());
-    Ok(())
+    match unreadable.len() {
+        0 => Ok(()),
+        n => Err(format!(
+            "{n} results director{} left out of the index (listed above)",
+            if n == 1 { "y" } else { "ies" }
+        )),
+    }
+}
+
+/// What the index shows of one results directory: its claims and the figures its report
+/// draws.
+fn index_entry<'a>(dir: &'a str, c: &'a Collected) -> Result<report::index::Indexed<'a>, String> {
+    let rates = report::fit_rates(&c.experiment, &c.runs);
+    let figures = report::figures::plan(&c.experiment, &c.runs)?;
+    let maps = report::figures::plan_maps(&c.experiment, &c.runs, &figures)?;
+    Ok(report::index::Indexed {
+        dir,
+        experiment: &c.experiment,
+        claims: report::claims::evaluate(&c.experiment, &rates, &c.runs),
+        figures,
+        maps,
+        unreadable_runs: c.unreadable.len(),
+    })
 }
 
 fn list_methods() {

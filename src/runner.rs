@@ -1,17 +1,22 @@
 //! Runs an expanded experiment: every run in parallel across a rayon pool, each written
-//! to its own file. Numbers do not depend on the pool size: each run is sequential.
+//! to its own file. Numbers do not depend on the pool size: each run is sequential. Processes
+//! that run one experiment into one results directory at the same time share its runs
+//! (`runner/locks.rs`).
+
+mod locks;
 
 use std::fs;
 use std::io::{self, IsTerminal};
 use std::path::{Path, PathBuf};
-use std::time::{SystemTime, UNIX_EPOCH};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::benchmarks::AnyProblem;
 use crate::experiment::{Experiment, RunSpec};
-use crate::output::{describe_if_missing, run_path, write_run, RunStatus};
+use crate::output::{
+    describe_if_missing, remove_dead_temps, run_path, write_atomically, write_run, RunStatus,
+};
 use crate::params::get_usize;
 use crate::solver::simulate;
 
@@ -31,6 +36,8 @@ pub struct RunOptions {
 pub struct MatrixOutcome {
     pub written: usize,
     pub skipped: usize,
+    /// Runs another process computed into the same directory while this one ran.
+    pub elsewhere: usize,
     /// `run_id: message` of each run that did not finish normally.
     pub diverged: Vec<String>,
     pub failed: Vec<String>,
@@ -44,41 +51,66 @@ pub fn results_dir(out: &Path, experiment: &Experiment) -> PathBuf {
 pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Result<MatrixOutcome> {
     let dir = results_dir(&options.out, experiment);
     fs::create_dir_all(dir.join("runs"))?;
-    write_experiment_copy(&dir, &experiment.source_text)?;
+    write_experiment_copy(&dir, experiment)?;
+    remove_dead_temps(&dir)?;
+    locks::remove_leftovers(&dir)?;
+    let mut outcome = MatrixOutcome::default();
+    let mut runs: Vec<&RunSpec> = experiment.runs.iter().collect();
+    // Runs another process held but ended without writing come back for another pass.
+    while !runs.is_empty() {
+        runs = run_pass(&dir, &experiment.name, &runs, options, &mut outcome)?;
+    }
+    outcome.diverged.sort();
+    outcome.failed.sort();
+    Ok(outcome)
+}
 
-    let (todo, done): (Vec<&RunSpec>, Vec<&RunSpec>) = experiment
-        .runs
+/// Computes the runs of `runs` that have no file (every one with `force`) and whose lock this
+/// process takes, then waits for those another process holds; returns the runs of these that
+/// their holder did not write.
+fn run_pass<'a>(
+    dir: &Path,
+    name: &str,
+    runs: &[&'a RunSpec],
+    options: &RunOptions,
+    outcome: &mut MatrixOutcome,
+) -> io::Result<Vec<&'a RunSpec>> {
+    let (todo, done): (Vec<&RunSpec>, Vec<&RunSpec>) = runs
         .iter()
-        .partition(|run| options.force || !run_path(&dir, &run.run_id).exists());
+        .partition(|run| options.force || !run_path(dir, &run.run_id).exists());
     // A skipped run still gets the XDMF description it lacks.
     for run in &done {
-        describe_if_missing(&run_path(&dir, &run.run_id))?;
+        describe_if_missing(&run_path(dir, &run.run_id))?;
     }
     let mut todo = todo;
     // Longest first, so the pool does not end waiting on one large run.
     todo.sort_by_cached_key(|run| std::cmp::Reverse(estimated_cost(run)));
 
-    let progress = progress_bar(&experiment.name, todo.len());
+    let progress = progress_bar(name, todo.len());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs)
         .build()
         .map_err(io::Error::other)?;
+    let claims = locks::Claims::new(dir, options.force);
     let results: Vec<io::Result<(String, RunStatus, String)>> = pool.install(|| {
         todo.par_iter()
+            .filter(|run| claims.take(run))
             .map(|run| {
                 let record = simulate(run);
-                write_run(&dir, &record)?;
+                write_run(dir, &record)?;
                 progress.inc(1);
                 Ok((run.run_id.clone(), record.status, record.message))
+            })
+            .inspect(|result| {
+                if let Ok((run_id, _, _)) = result {
+                    claims.release(run_id);
+                }
             })
             .collect()
     });
     progress.finish_and_clear();
 
-    let mut outcome = MatrixOutcome {
-        skipped: done.len(),
-        ..Default::default()
-    };
+    outcome.skipped += done.len();
     for result in results {
         let (run_id, status, message) = result?;
         outcome.written += 1;
@@ -88,9 +120,9 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
             RunStatus::Failed => outcome.failed.push(format!("{run_id}: {message}")),
         }
     }
-    outcome.diverged.sort();
-    outcome.failed.sort();
-    Ok(outcome)
+    let waited = claims.wait_for_others(name)?;
+    outcome.elsewhere += waited.elsewhere;
+    Ok(waited.orphans)
 }
 
 /// A run's cost in particle-steps: its particles (`cells * ppc` per axis) times the time
@@ -112,31 +144,88 @@ pub fn estimated_cost(run: &RunSpec) -> u64 {
     particles.saturating_mul(steps.max(1) as u64)
 }
 
-/// Shards of one study, on several hosts, all write the same copy: an identical copy is left
-/// alone, and a new one is written under a temporary name unique to this host, process and
-/// moment (`write_atomically` names it by process id only, which processes on different hosts
-/// can share) and renamed into place, so a reader never sees a partial copy.
-pub fn write_experiment_copy(dir: &Path, text: &str) -> io::Result<()> {
-    let path = dir.join(EXPERIMENT_COPY);
-    if fs::read_to_string(&path).is_ok_and(|old| old == text) {
+/// Experiments run or submitted together must differ in `name`, since each writes to
+/// `OUT/<name>/`.
+pub fn check_distinct_names(experiments: &[Experiment]) -> Result<(), String> {
+    for (i, a) in experiments.iter().enumerate() {
+        if let Some(b) = experiments[..i].iter().find(|b| b.name == a.name) {
+            return Err(format!(
+                "{} and {} both name the experiment '{}' (results go to OUT/<name>/)",
+                b.source_path.display(),
+                a.source_path.display(),
+                a.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Where a results directory records the experiment file its copy was last written from (its
+/// canonical path). It lives in `runs/`, which is not committed and which `make reproduce`
+/// does not compare, since the path is this machine's.
+const COPY_SOURCE: &str = ".experiment-source";
+
+/// Whether `experiment` may write its copy into `dir`. The same text may come from anywhere
+/// (the shards of a study, a task reading the copy itself), and new text from the file the copy
+/// was last written from (an edited experiment file, rerun); new text from another file of the
+/// same `name` is refused, naming both, as it would orphan the runs of the first. A directory
+/// without a record (written before records were kept) takes any file.
+pub fn check_copy(dir: &Path, experiment: &Experiment) -> Result<(), String> {
+    let copy = dir.join(EXPERIMENT_COPY);
+    let Ok(text) = fs::read_to_string(&copy) else {
+        return Ok(());
+    };
+    let Ok(recorded) = fs::read_to_string(dir.join("runs").join(COPY_SOURCE)) else {
+        return Ok(());
+    };
+    let recorded = PathBuf::from(recorded.trim_end());
+    let source = canonical(&experiment.source_path);
+    if text == experiment.source_text || source == recorded || source == canonical(&copy) {
         return Ok(());
     }
-    let host = fs::read_to_string("/proc/sys/kernel/hostname")
-        .or_else(|_| std::env::var("HOSTNAME"))
-        .unwrap_or_default();
-    let nanos = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let tmp = dir.join(format!(
-        ".{EXPERIMENT_COPY}.tmp-{}-{}-{nanos}",
-        host.trim(),
-        std::process::id()
-    ));
-    let written = fs::write(&tmp, text).and_then(|()| fs::rename(&tmp, &path));
-    if written.is_err() {
-        let _ = fs::remove_file(&tmp);
+    Err(format!(
+        "{}: the experiment '{}' already in {} comes from {}, and its text differs; one --out \
+         holds one experiment of a name, so give one of them another `name` or use another \
+         --out (if {} was renamed to {}, remove {})",
+        experiment.source_path.display(),
+        experiment.name,
+        copy.display(),
+        recorded.display(),
+        recorded.display(),
+        source.display(),
+        dir.join("runs").join(COPY_SOURCE).display()
+    ))
+}
+
+/// The absolute path of a file with symbolic links resolved, or as absolute as it gets.
+fn canonical(path: &Path) -> PathBuf {
+    fs::canonicalize(path)
+        .or_else(|_| std::path::absolute(path))
+        .unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// Writes the copy of the experiment file beside its runs (`check_copy` first), and records
+/// the file it came from unless that is the copy itself (an identical copy keeps the record it
+/// has). Shards of one study, on several
+/// hosts, all write the same copy: an identical copy is left alone, and a new one is written
+/// under a temporary name unique to host and process and renamed into place, so a reader never
+/// sees a partial copy.
+pub fn write_experiment_copy(dir: &Path, experiment: &Experiment) -> io::Result<()> {
+    let path = dir.join(EXPERIMENT_COPY);
+    let record = dir.join("runs").join(COPY_SOURCE);
+    let text = &experiment.source_text;
+    if !fs::read_to_string(&path).is_ok_and(|old| old == *text) {
+        check_copy(dir, experiment).map_err(io::Error::other)?;
+        write_atomically(&path, |tmp| fs::write(tmp, text))?;
+    } else if record.exists() {
+        return Ok(());
     }
-    written
+    let source = canonical(&experiment.source_path);
+    if source == canonical(&path) {
+        return Ok(());
+    }
+    let line = format!("{}\n", source.display());
+    write_atomically(&record, |tmp| fs::write(tmp, &line))
 }
 
 /// A bar on a terminal; nothing when stderr is piped or redirected.

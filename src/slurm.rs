@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 
 use crate::experiment::Experiment;
-use crate::runner::{results_dir, write_experiment_copy, EXPERIMENT_COPY};
+use crate::runner::{check_distinct_names, results_dir, write_experiment_copy, EXPERIMENT_COPY};
 use crate::shard::Plan;
 
 /// What `mpmlab slurm` was asked for.
@@ -41,16 +41,7 @@ pub const DEFAULT_SHARDS: usize = 8;
 /// array script, submits it and, with `wait`, checks the outcome. The job id goes to stdout,
 /// everything else to stderr.
 pub fn submit_study(experiments: &[Experiment], options: Options) -> Result<(), String> {
-    for (i, a) in experiments.iter().enumerate() {
-        if let Some(b) = experiments[..i].iter().find(|b| b.name == a.name) {
-            return Err(format!(
-                "{} and {} both name the experiment '{}' (results go to OUT/<name>/)",
-                b.source_path.display(),
-                a.source_path.display(),
-                a.name
-            ));
-        }
-    }
+    check_distinct_names(experiments)?;
     let runs: usize = experiments.iter().map(|e| e.runs.len()).sum();
     let shards = match options.shards {
         Some(0) => return Err("--shards must be at least 1".into()),
@@ -106,7 +97,7 @@ pub fn submit_study(experiments: &[Experiment], options: Options) -> Result<(), 
     for experiment in experiments {
         let dir = results_dir(&job.out, experiment);
         fs::create_dir_all(&dir)
-            .and_then(|()| write_experiment_copy(&dir, &experiment.source_text))
+            .and_then(|()| write_experiment_copy(&dir, experiment))
             .map_err(|e| format!("{}: {e}", dir.display()))?;
     }
     fs::create_dir_all(job.slurm_dir())

@@ -63,7 +63,7 @@ fn a_figure_of_two_listed_methods_draws_those_two() {
     let rates = report::fit_rates(exp, runs);
     let failures = report::check(exp, &rates, runs);
     assert!(failures.is_empty(), "{failures:?}");
-    let written = report::write_report(&dir, exp, runs, &rates, Some(&failures)).unwrap();
+    let written = report::write_report(&dir, exp, runs, &[], &rates, Some(&failures)).unwrap();
     let file = Path::new("figures/multi_select_method_mpm_musl+mpm_tls_displacement_rms.png");
     assert_eq!(written.figures, [file]);
     let png = std::fs::read(dir.join(file)).unwrap();

@@ -133,6 +133,7 @@ fn runs_are_reproducible_skipped_and_divergence_is_recorded() {
         &dir_a,
         &collected.experiment,
         &collected.runs,
+        &collected.unreadable,
         &rates,
         Some(&failures),
     )

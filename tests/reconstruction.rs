@@ -49,7 +49,15 @@ fn checked_report(collected: &mpmlab::collect::Collected, out: &Path, needles: &
     let failures = report::check(&collected.experiment, &rates, &collected.runs);
     assert!(failures.is_empty(), "{failures:?}");
     let dir = results_dir(out, &collected.experiment);
-    report::write_report(&dir, &collected.experiment, &collected.runs, &rates, None).unwrap();
+    report::write_report(
+        &dir,
+        &collected.experiment,
+        &collected.runs,
+        &collected.unreadable,
+        &rates,
+        None,
+    )
+    .unwrap();
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     for needle in needles {
         assert!(md.contains(needle), "missing {needle:?} in\n{md}");

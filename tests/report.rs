@@ -259,7 +259,7 @@ fn report_files_are_written_and_deterministic() {
     let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
     let reports: Vec<_> = dirs
         .iter()
-        .map(|d| write_report(d.path(), &exp, &runs, &rates, Some(&failures)).unwrap())
+        .map(|d| write_report(d.path(), &exp, &runs, &[], &rates, Some(&failures)).unwrap())
         .collect();
     let report = &reports[0];
     assert_eq!(
@@ -431,7 +431,7 @@ fn named_figures_take_their_name_title_and_paper() {
 fn figure_names(exp: &Experiment) -> (tempfile::TempDir, Vec<String>) {
     let dir = tempfile::tempdir().unwrap();
     let runs = runs();
-    let report = write_report(dir.path(), exp, &runs, &fit_rates(exp, &runs), None).unwrap();
+    let report = write_report(dir.path(), exp, &runs, &[], &fit_rates(exp, &runs), None).unwrap();
     let names = report
         .figures
         .iter()
@@ -472,7 +472,7 @@ fn a_matrix_over_cells_alone_is_one_group() {
     let dir = tempfile::tempdir().unwrap();
     let rates = fit_rates(&exp, &runs);
     assert!(rates.iter().all(|r| r.group.is_empty() && r.n == 3));
-    let report = write_report(dir.path(), &exp, &runs, &rates, None).unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], &rates, None).unwrap();
     assert_eq!(
         report.figures,
         [std::path::PathBuf::from("figures/gong_conv_all_l2.png")]
@@ -492,7 +492,7 @@ fn figures_no_longer_drawn_are_removed() {
     let stale = dir.path().join("figures").join("old_figure.png");
     std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
     std::fs::write(&stale, b"old").unwrap();
-    let report = write_report(dir.path(), &exp, &runs, &fit_rates(&exp, &runs), None).unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], &fit_rates(&exp, &runs), None).unwrap();
     assert!(!stale.exists());
     assert!(!report.figures.is_empty());
     assert!(report.figures.iter().all(|f| dir.path().join(f).exists()));
@@ -536,7 +536,7 @@ fn history_figures_draw_every_run_and_name_unknown_probes() {
     ];
     let exp = experiment(vec![], vec![history("tip")]);
     let dir = tempfile::tempdir().unwrap();
-    let report = write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], &[], None).unwrap();
     assert_eq!(
         report.figures,
         [Path::new("figures/gong_conv_tip_G_0.1_cells_8.png")]
@@ -544,7 +544,7 @@ fn history_figures_draw_every_run_and_name_unknown_probes() {
     assert!(dir.path().join(&report.figures[0]).exists());
 
     let exp = experiment(vec![], vec![history("root")]);
-    let error = write_report(dir.path(), &exp, &runs, &[], None).unwrap_err();
+    let error = write_report(dir.path(), &exp, &runs, &[], &[], None).unwrap_err();
     let message = error.to_string();
     assert!(message.contains("probe 'root'"), "{message}");
     assert!(message.contains("the runs record: tip"), "{message}");
@@ -577,7 +577,7 @@ fn probes_tables_list_every_run_and_name_unknown_probes() {
     let mut exp = experiment(vec![], vec![]);
     exp.tables = vec![probes_table("tip")];
     let dir = tempfile::tempdir().unwrap();
-    write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    write_report(dir.path(), &exp, &runs, &[], &[], None).unwrap();
     let md = read(dir.path(), "report.md");
     assert!(md.contains("### Probe tip after t = 0.5"), "{md}");
     assert!(md.contains("| ok | 0.75 | 0.1708 | 2 | 1 | 0.5 |"), "{md}");
@@ -587,7 +587,7 @@ fn probes_tables_list_every_run_and_name_unknown_probes() {
     );
 
     exp.tables = vec![probes_table("root")];
-    let message = write_report(dir.path(), &exp, &runs, &[], None)
+    let message = write_report(dir.path(), &exp, &runs, &[], &[], None)
         .unwrap_err()
         .to_string();
     assert!(message.contains("probe 'root'"), "{message}");
@@ -610,7 +610,7 @@ fn conservation_tables_list_each_runs_mapping_errors() {
         probe: None,
     }];
     let dir = tempfile::tempdir().unwrap();
-    write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    write_report(dir.path(), &exp, &runs, &[], &[], None).unwrap();
     let md = read(dir.path(), "report.md");
     assert!(
         md.contains("### Largest relative mass and momentum errors"),
@@ -688,7 +688,7 @@ fn field_maps_are_planned_per_group_on_one_scale() {
     }
 
     let dir = tempfile::tempdir().unwrap();
-    let report = write_report(dir.path(), &exp, &runs, &[], None).unwrap();
+    let report = write_report(dir.path(), &exp, &runs, &[], &[], None).unwrap();
     assert_eq!(report.figures, files);
     for file in &report.figures {
         assert!(dir.path().join(file).exists());
@@ -767,7 +767,7 @@ fn paper_claims_get_verdicts_and_fail_the_check_when_unexplained() {
     let failed: Vec<usize> = check(&exp, &rates, &runs).iter().map(|f| f.line).collect();
     assert_eq!(failed, [2, 4]);
     let dir = tempfile::tempdir().unwrap();
-    write_report(dir.path(), &exp, &runs, &rates, None).unwrap();
+    write_report(dir.path(), &exp, &runs, &[], &rates, None).unwrap();
     let md = read(dir.path(), "report.md");
     assert!(
         md.contains("| Gong 2015, Fig 4.7 | second order | displacement l2 | rate 3 | 2 | ± 0.1 | differs |  | docs/NOTES.md, item 9 |"),
@@ -779,8 +779,9 @@ fn paper_claims_get_verdicts_and_fail_the_check_when_unexplained() {
         claims: outcomes,
         figures: Vec::new(),
         maps: Vec::new(),
+        unreadable_runs: 0,
     };
-    let front = index::index_md(&[indexed]);
+    let front = index::index_md(&[indexed], &[]);
     assert!(
         front.contains("| reproduced | 1 |\n| differs | 1 |\n| differs, unexplained | 1 |"),
         "{front}"

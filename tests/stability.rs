@@ -75,6 +75,7 @@ fn runs_either_side_of_the_limit_are_told_apart() {
         &dir,
         &collected.experiment,
         &collected.runs,
+        &collected.unreadable,
         &rates,
         Some(&failures),
     )

@@ -5,7 +5,7 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{read_f64, read_i64, read_str};
+use super::reader::{open_dataset, read_f64, read_i64, read_str};
 use super::writer::{attr_f64, attr_i64, attr_str, dataset};
 
 const GROUP: &str = "elements";
@@ -147,9 +147,9 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ElementRecord>> {
         return Ok(None);
     }
     let group: Group = file.group(GROUP)?;
-    let real = |name: &str| group.dataset(name)?.read_raw::<f64>();
-    let int = |name: &str| group.dataset(name)?.read_raw::<i64>();
-    let lower = group.dataset("lower")?;
+    let real = |name: &str| open_dataset(&group, name)?.read_raw::<f64>();
+    let int = |name: &str| open_dataset(&group, name)?.read_raw::<i64>();
+    let lower = open_dataset(&group, "lower")?;
     Ok(Some(ElementRecord {
         formula: read_str(&group, "formula")?,
         conservation: read_str(&group, "conservation")?,

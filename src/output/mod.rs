@@ -289,10 +289,15 @@ mod shape_functions;
 mod writer;
 mod xdmf;
 
-pub use atomic::{describe_if_missing, run_path, write_atomically, write_run};
+pub use atomic::{
+    describe_if_missing, host_tag, remove_dead_temps, run_path, temp_path, this_host,
+    write_all_atomically, write_atomically, write_run, TempHost, TempWriter,
+};
 pub use elements::ElementRecord;
 pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
-pub use reader::{read_final_state, read_probes, read_summary};
+pub use reader::{
+    open_hdf5, open_run_file, read_final_state, read_probes, read_summary, UnreadableRun,
+};
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, GridErrors, GridHistory, History, MethodParts,

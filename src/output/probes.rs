@@ -4,7 +4,7 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{read_i64, read_str};
+use super::reader::{open_attr, open_dataset, read_i64, read_str};
 use super::writer::{attr_f64, attr_i64, attr_str, dataset};
 
 const GROUP: &str = "probes";
@@ -142,14 +142,14 @@ pub fn read(file: &File) -> hdf5::Result<Vec<ProbeRecord>> {
         let g = group.group(&name)?;
         probes.push(ProbeRecord {
             particle: read_i64(&g, PARTICLE)?,
-            x0: g.attr(X0)?.read_raw()?,
+            x0: open_attr(&g, X0)?.read_raw()?,
             quantity: read_str(&g, QUANTITY)?,
-            component: g.attr(COMPONENT)?.read_raw()?,
+            component: open_attr(&g, COMPONENT)?.read_raw()?,
             reference_kind: read_str(&g, REFERENCE)?,
-            time: g.dataset(TIME)?.read_raw()?,
-            step: g.dataset(STEP)?.read_raw()?,
-            value: g.dataset(VALUE)?.read_raw()?,
-            reference: g.dataset(REFERENCE)?.read_raw()?,
+            time: open_dataset(&g, TIME)?.read_raw()?,
+            step: open_dataset(&g, STEP)?.read_raw()?,
+            value: open_dataset(&g, VALUE)?.read_raw()?,
+            reference: open_dataset(&g, REFERENCE)?.read_raw()?,
             name,
         });
     }

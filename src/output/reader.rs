@@ -1,30 +1,128 @@
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::fs;
+use std::io::{self, Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
 
 use hdf5::types::{TypeDescriptor, VarLenUnicode};
-use hdf5::Location;
+use hdf5::{Attribute, Dataset, Group, Location};
 use ndarray::s;
 
 use super::{
     elements, probes, reconstruction, shape_functions, ParticleState, ProbeRecord, RunStatus,
-    RunSummary, VelocityHistory, ERROR_FIELDS_WITH_GRID, GRID_VELOCITY, NORMS,
+    RunSummary, VelocityHistory, ERROR_FIELDS_WITH_GRID, GRID_VELOCITY, NORMS, SCHEMA_VERSION,
 };
 use super::{
     ELEMENT_NORMS, RECONSTRUCTION_FIELDS, RECONSTRUCTION_NORMS, SHAPE_FIELDS, SHAPE_NORMS,
 };
 use crate::params::{ParamValue, Params};
 
-/// Reads what the report needs from one run file. A reconstruction or shape-function run has
-/// no time steps: its `steps` is 0 and its `dt` NaN.
-pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
-    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
-    let file = hdf5::File::open(path).map_err(context)?;
-    let status_text = read_str(&file, "status").map_err(context)?;
-    let status = RunStatus::parse(&status_text)
-        .ok_or_else(|| format!("{}: unknown status '{status_text}'", path.display()))?;
-    let reconstruction = reconstruction::read(&file).map_err(context)?;
-    let elements = elements::read(&file).map_err(context)?;
-    let shape_functions = shape_functions::read(&file).map_err(context)?;
+/// A file in a results directory's `runs/` that the report cannot use.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnreadableRun {
+    /// Relative to the results directory: `runs/<name>.h5`.
+    pub file: PathBuf,
+    /// Why, in plain words: "not an HDF5 file", "truncated: ...", "lacks /history/x", ...
+    pub reason: String,
+}
+
+/// Opens an HDF5 file, or says why it cannot be opened: not an HDF5 file, truncated, or
+/// damaged otherwise (in HDF5's words).
+pub fn open_hdf5(path: &Path) -> Result<hdf5::File, String> {
+    hdf5::File::open(path).map_err(|e| match superblock_end(path) {
+        Ok(None) => "not an HDF5 file".to_string(),
+        Ok(Some((len, end))) if len < end => format!("truncated: {len} of {end} bytes"),
+        _ => format!("damaged: {}", hdf5_words(&e)),
+    })
+}
+
+/// Opens a run file this version of the layout describes.
+pub fn open_run_file(path: &Path) -> Result<hdf5::File, String> {
+    let file = open_hdf5(path)?;
+    let version = read_i64(&file, "schema_version").map_err(reason)?;
+    if version != SCHEMA_VERSION {
+        return Err(format!(
+            "written with layout version {version}, this mpmlab reads version {SCHEMA_VERSION} \
+             (rerun it with --force)"
+        ));
+    }
+    Ok(file)
+}
+
+/// The HDF5 signature, which the format allows at offset 0, 512, 1024, 2048, ...
+const SIGNATURE: &[u8; 8] = b"\x89HDF\r\n\x1a\n";
+
+/// The file's length and where its superblock says it ends; `None` when it has no HDF5
+/// signature. The end is 0 for a superblock version this does not know.
+fn superblock_end(path: &Path) -> io::Result<Option<(u64, u64)>> {
+    let mut file = fs::File::open(path)?;
+    let len = file.metadata()?.len();
+    let mut offset = 0;
+    while offset + SIGNATURE.len() as u64 <= len {
+        let mut block = Vec::new();
+        file.seek(SeekFrom::Start(offset))?;
+        (&mut file).take(64).read_to_end(&mut block)?;
+        if block.starts_with(SIGNATURE) {
+            return Ok(Some((len, end_address(&block).unwrap_or(0))));
+        }
+        offset = if offset == 0 { 512 } else { 2 * offset };
+    }
+    Ok(None)
+}
+
+/// The base address plus the end-of-file address of a superblock (format versions 0 to 3),
+/// i.e. the length the file must have.
+fn end_address(block: &[u8]) -> Option<u64> {
+    let (size_of_offsets, base_at) = match *block.get(8)? {
+        0 => (*block.get(13)?, 24),
+        1 => (*block.get(13)?, 28),
+        2 | 3 => (*block.get(9)?, 12),
+        _ => return None,
+    };
+    let size = usize::from(size_of_offsets);
+    if ![2, 4, 8].contains(&size) {
+        return None;
+    }
+    let address = |at: usize| {
+        let bytes = block.get(at..at + size)?;
+        Some(bytes.iter().rev().fold(0u64, |a, &b| a << 8 | u64::from(b)))
+    };
+    // The base address, then the free-space (versions 0, 1) or superblock extension (2, 3)
+    // address, then the end of file.
+    address(base_at)?.checked_add(address(base_at + 2 * size)?)
+}
+
+/// The reason a read failed: the words of the checks below, or HDF5's for damage they do not
+/// see.
+fn reason(e: hdf5::Error) -> String {
+    match e {
+        hdf5::Error::Internal(words) => words,
+        other => format!("damaged: {}", hdf5_words(&other)),
+    }
+}
+
+/// HDF5's description of an error without the library function it names
+/// (`H5Fopen(): unable to open file: ...`).
+fn hdf5_words(e: &hdf5::Error) -> String {
+    let text = e.to_string();
+    match text.split_once("(): ") {
+        Some((function, words)) if function.starts_with("H5") => words.to_string(),
+        _ => text,
+    }
+}
+
+/// Reads what the report needs from a run file (`open_run_file`). A reconstruction or
+/// shape-function run has no time steps: its `steps` is 0 and its `dt` NaN.
+pub fn read_summary(file: &hdf5::File) -> Result<RunSummary, String> {
+    summary(file).map_err(reason)
+}
+
+fn summary(file: &hdf5::File) -> hdf5::Result<RunSummary> {
+    let status_text = read_str(file, "status")?;
+    let status =
+        RunStatus::parse(&status_text).ok_or_else(|| format!("unknown status '{status_text}'"))?;
+    let reconstruction = reconstruction::read(file)?;
+    let elements = elements::read(file)?;
+    let shape_functions = shape_functions::read(file)?;
     let unstepped = match (&reconstruction, &elements, &shape_functions) {
         (Some(r), _, _) => Some(unstepped_norms(
             &RECONSTRUCTION_FIELDS,
@@ -42,35 +140,35 @@ pub fn read_summary(path: &Path) -> Result<RunSummary, String> {
     let (final_norms, steps, dt, velocity_history) = match unstepped {
         Some(norms) => (norms, 0, f64::NAN, None),
         None => (
-            simulation_norms(&file).map_err(context)?,
-            read_i64(&file, "steps").map_err(context)? as usize,
-            read_f64(&file, "dt").map_err(context)?,
-            velocity_history(&file).map_err(context)?,
+            simulation_norms(file)?,
+            read_i64(file, "steps")? as usize,
+            read_f64(file, "dt")?,
+            velocity_history(file)?,
         ),
     };
-    let matrix = file.group("matrix").map_err(context)?;
+    let matrix = group(file, "matrix")?;
     Ok(RunSummary {
-        run_id: read_str(&file, "run_id").map_err(context)?,
-        experiment: read_str(&file, "experiment").map_err(context)?,
-        benchmark: read_str(&file, "benchmark").map_err(context)?,
-        method: read_str(&file, "method").map_err(context)?,
-        dim: read_i64(&file, "dim").map_err(context)? as usize,
-        cells: read_i64(&file, "cells").map_err(context)? as usize,
-        ppc: read_i64(&file, "ppc").map_err(context)? as usize,
-        h: read_f64(&file, "h").map_err(context)?,
+        run_id: read_str(file, "run_id")?,
+        experiment: read_str(file, "experiment")?,
+        benchmark: read_str(file, "benchmark")?,
+        method: read_str(file, "method")?,
+        dim: read_i64(file, "dim")? as usize,
+        cells: read_i64(file, "cells")? as usize,
+        ppc: read_i64(file, "ppc")? as usize,
+        h: read_f64(file, "h")?,
         dt,
         steps,
         status,
-        message: read_str(&file, "message").map_err(context)?,
-        wall_seconds: read_f64(&file, "wall_seconds").map_err(context)?,
-        axes: read_params(&matrix).map_err(context)?,
+        message: read_str(file, "message")?,
+        wall_seconds: read_f64(file, "wall_seconds")?,
+        axes: read_params(&matrix)?,
         final_norms,
         reconstruction,
         elements,
         shape_functions,
         velocity_history,
-        max_mass_error: conservation_attr(&file, "max_mass_error"),
-        max_momentum_error: conservation_attr(&file, "max_momentum_error"),
+        max_mass_error: conservation_attr(file, "max_mass_error"),
+        max_momentum_error: conservation_attr(file, "max_momentum_error"),
         profile: None,
         probes: Vec::new(),
         final_state: None,
@@ -85,30 +183,29 @@ fn conservation_attr(file: &hdf5::File, name: &str) -> f64 {
 }
 
 /// The `/probes` of a run file (none for a run without them).
-pub fn read_probes(path: &Path) -> Result<Vec<ProbeRecord>, String> {
-    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
-    let file = hdf5::File::open(path).map_err(context)?;
-    probes::read(&file).map_err(context)
+pub fn read_probes(file: &hdf5::File) -> Result<Vec<ProbeRecord>, String> {
+    probes::read(file).map_err(reason)
 }
 
 /// The last sample of a simulation run; `None` for a run without samples.
-pub fn read_final_state(path: &Path) -> Result<Option<ParticleState>, String> {
-    let context = |e: hdf5::Error| format!("{}: {e}", path.display());
-    let file = hdf5::File::open(path).map_err(context)?;
-    let times = file
-        .dataset("history/time")
-        .and_then(|t| t.read_raw::<f64>())
-        .map_err(context)?;
+pub fn read_final_state(file: &hdf5::File) -> Result<Option<ParticleState>, String> {
+    final_state(file).map_err(reason)
+}
+
+fn final_state(file: &hdf5::File) -> hdf5::Result<Option<ParticleState>> {
+    let times = shaped(file, "history/time", &[None])?.read_raw::<f64>()?;
     let Some(&time) = times.last() else {
         return Ok(None);
     };
-    let last = times.len() - 1;
+    let (samples, last) = (Some(times.len()), times.len() - 1);
+    let (x0, np, dim) = particles(file)?;
     // Row `last` of a dataset whose first axis is the sample, flattened.
-    let read = |name: &str| -> hdf5::Result<Vec<f64>> {
-        let ds = file.dataset(name)?;
-        Ok(match ds.ndim() {
-            2 => ds.read_slice_1d::<f64, _>(s![last, ..])?.to_vec(),
-            3 => ds
+    let read = |name: &str, per_particle: &[Option<usize>]| -> hdf5::Result<Vec<f64>> {
+        let shape: Vec<Option<usize>> = [samples, np].iter().chain(per_particle).copied().collect();
+        let ds = shaped(file, name, &shape)?;
+        Ok(match per_particle.len() {
+            0 => ds.read_slice_1d::<f64, _>(s![last, ..])?.to_vec(),
+            1 => ds
                 .read_slice_2d::<f64, _>(s![last, .., ..])?
                 .iter()
                 .copied()
@@ -120,36 +217,44 @@ pub fn read_final_state(path: &Path) -> Result<Option<ParticleState>, String> {
                 .collect(),
         })
     };
-    let x0 = file.dataset("particles/X").map_err(context)?;
     Ok(Some(ParticleState {
-        dim: x0.shape().get(1).copied().unwrap_or(0),
+        dim: dim.unwrap_or(0),
         time,
-        x0: x0.read_raw::<f64>().map_err(context)?,
-        x: read("history/x").map_err(context)?,
-        velocity: read("history/v").map_err(context)?,
-        stress: read("history/stress").map_err(context)?,
-        density: read("history/density").map_err(context)?,
-        volume: read("errors/volume").map_err(context)?,
+        x0,
+        x: read("history/x", &[dim])?,
+        velocity: read("history/v", &[dim])?,
+        stress: read("history/stress", &[dim, dim])?,
+        density: read("history/density", &[])?,
+        volume: read("errors/volume", &[])?,
     }))
+}
+
+/// `/particles/X` (Np x D, flattened) with Np and D, which the shapes of the per-particle
+/// datasets must repeat. D is at least 1.
+fn particles(file: &hdf5::File) -> hdf5::Result<(Vec<f64>, Option<usize>, Option<usize>)> {
+    let x0 = shaped(file, "particles/X", &[None, None])?;
+    let (np, dim) = (x0.shape()[0], x0.shape()[1]);
+    if dim == 0 {
+        return Err("dataset /particles/X has no coordinates".into());
+    }
+    Ok((x0.read_raw::<f64>()?, Some(np), Some(dim)))
 }
 
 /// The l2 velocity error per sample and the l2 norm of the velocity at the first sample;
 /// `None` for a run without samples (a failed run's datasets are empty). Reads only the first
 /// row of `/history/v` and `/errors/volume`.
 fn velocity_history(file: &hdf5::File) -> hdf5::Result<Option<VelocityHistory>> {
-    let time = file.dataset("errors/time")?.read_raw::<f64>()?;
+    let time = shaped(file, "errors/time", &[None])?.read_raw::<f64>()?;
     if time.is_empty() {
         return Ok(None);
     }
-    let l2_error = file
-        .dataset("errors/norms/l2_velocity")?
-        .read_raw::<f64>()?;
-    let v = file
-        .dataset("history/v")?
-        .read_slice_2d::<f64, _>(s![0, .., ..])?;
-    let volume = file
-        .dataset("errors/volume")?
-        .read_slice_1d::<f64, _>(s![0, ..])?;
+    let samples = Some(time.len());
+    let l2_error = shaped(file, "errors/norms/l2_velocity", &[samples])?.read_raw::<f64>()?;
+    let (_, np, dim) = particles(file)?;
+    let v =
+        shaped(file, "history/v", &[samples, np, dim])?.read_slice_2d::<f64, _>(s![0, .., ..])?;
+    let volume =
+        shaped(file, "errors/volume", &[samples, np])?.read_slice_1d::<f64, _>(s![0, ..])?;
     let sum: f64 = v
         .rows()
         .into_iter()
@@ -168,7 +273,7 @@ type FinalNorms = BTreeMap<(String, String), f64>;
 /// The final norms of every field; the grid velocity's only when the file has them (a file
 /// written before they existed leaves them out, and the report shows them empty).
 fn simulation_norms(file: &hdf5::File) -> hdf5::Result<FinalNorms> {
-    let norms = file.group("errors/norms")?;
+    let norms = group(file, "errors/norms")?;
     let written = norms.attr_names()?;
     let mut final_norms = BTreeMap::new();
     for field in ERROR_FIELDS_WITH_GRID {
@@ -200,28 +305,110 @@ fn unstepped_norms(fields: &[&str], norms: &[&str], values: &[f64]) -> FinalNorm
 fn read_params(loc: &Location) -> hdf5::Result<Params> {
     let mut params = Params::new();
     for name in loc.attr_names()? {
-        let attr = loc.attr(&name)?;
+        let attr = open_attr(loc, &name)?;
         let value = match attr.dtype()?.to_descriptor()? {
-            TypeDescriptor::Integer(_) => ParamValue::Int(attr.read_scalar::<i64>()?),
+            TypeDescriptor::Integer(_) => ParamValue::Int(read_i64(loc, &name)?),
             TypeDescriptor::Float(_) if attr.is_scalar() => {
-                ParamValue::Float(attr.read_scalar::<f64>()?)
+                ParamValue::Float(read_f64(loc, &name)?)
             }
             TypeDescriptor::Float(_) => ParamValue::List(attr.read_raw::<f64>()?),
-            _ => ParamValue::Str(attr.read_scalar::<VarLenUnicode>()?.to_string()),
+            _ => ParamValue::Str(read_str(loc, &name)?),
         };
         params.insert(name, value);
     }
     Ok(params)
 }
 
+/// Where `name` lies below `group`, as h5dump writes it: `/history/x`.
+fn path_in(group: &Group, name: &str) -> String {
+    format!("{}/{name}", group.name().trim_end_matches('/'))
+}
+
+/// The group `name` of `parent` (a path below it).
+fn group(parent: &Group, name: &str) -> hdf5::Result<Group> {
+    if !parent.link_exists(name) {
+        return Err(format!("lacks {}", path_in(parent, name)).into());
+    }
+    parent
+        .group(name)
+        .map_err(|_| format!("{} is not a group", path_in(parent, name)).into())
+}
+
+/// The dataset `name` of `group` (a path below it, such as `history/x`).
+pub(super) fn open_dataset(group: &Group, name: &str) -> hdf5::Result<Dataset> {
+    if !group.link_exists(name) {
+        return Err(format!("lacks {}", path_in(group, name)).into());
+    }
+    group
+        .dataset(name)
+        .map_err(|_| format!("{} is not a dataset", path_in(group, name)).into())
+}
+
+/// A dataset of the shape `expected`, where `None` takes any length on its axis: what a
+/// slice of it needs, and what keeps the arrays of one run the same length.
+fn shaped(group: &Group, name: &str, expected: &[Option<usize>]) -> hdf5::Result<Dataset> {
+    let ds = open_dataset(group, name)?;
+    let shape = ds.shape();
+    let path = path_in(group, name);
+    if shape.len() != expected.len() {
+        return Err(format!(
+            "dataset {path} has {} dimensions, {} expected",
+            shape.len(),
+            expected.len()
+        )
+        .into());
+    }
+    if shape
+        .iter()
+        .zip(expected)
+        .any(|(&n, e)| e.is_some_and(|e| e != n))
+    {
+        let text = |axes: Vec<String>| format!("({})", axes.join(", "));
+        let want = expected
+            .iter()
+            .map(|e| e.map_or("any".into(), |n| n.to_string()));
+        return Err(format!(
+            "dataset {path} has shape {}, {} expected",
+            text(shape.iter().map(usize::to_string).collect()),
+            text(want.collect())
+        )
+        .into());
+    }
+    Ok(ds)
+}
+
+/// The attribute `name` of `loc`, said in errors as `the attribute 'name'` (of the root) or
+/// `the attribute 'name' of /errors/norms`.
+fn attr_words(loc: &Location, name: &str) -> String {
+    match loc.name().as_str() {
+        "/" => format!("the attribute '{name}'"),
+        place => format!("the attribute '{name}' of {place}"),
+    }
+}
+
+pub(super) fn open_attr(loc: &Location, name: &str) -> hdf5::Result<Attribute> {
+    loc.attr(name)
+        .map_err(|_| format!("lacks {}", attr_words(loc, name)).into())
+}
+
+/// A scalar attribute read as `T`, which names `kind` in its error.
+fn scalar<T: hdf5::H5Type>(loc: &Location, name: &str, kind: &str) -> hdf5::Result<T> {
+    let attr = open_attr(loc, name)?;
+    if !attr.is_scalar() {
+        return Err(format!("{} is not a single value", attr_words(loc, name)).into());
+    }
+    attr.read_scalar::<T>()
+        .map_err(|_| format!("{} is not {kind}", attr_words(loc, name)).into())
+}
+
 pub(super) fn read_str(loc: &Location, name: &str) -> hdf5::Result<String> {
-    Ok(loc.attr(name)?.read_scalar::<VarLenUnicode>()?.to_string())
+    Ok(scalar::<VarLenUnicode>(loc, name, "a string")?.to_string())
 }
 
 pub(super) fn read_f64(loc: &Location, name: &str) -> hdf5::Result<f64> {
-    loc.attr(name)?.read_scalar::<f64>()
+    scalar(loc, name, "a number")
 }
 
 pub(super) fn read_i64(loc: &Location, name: &str) -> hdf5::Result<i64> {
-    loc.attr(name)?.read_scalar::<i64>()
+    scalar(loc, name, "an integer")
 }

@@ -5,7 +5,7 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{read_f64, read_i64, read_str};
+use super::reader::{open_dataset, read_f64, read_i64, read_str};
 use super::writer::{attr_f64, attr_i64, attr_str, dataset};
 
 const GROUP: &str = "reconstruction";
@@ -121,7 +121,7 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ReconstructionRecord>> {
         return Ok(None);
     }
     let group = file.group(GROUP)?;
-    let data = |name: &str| group.dataset(name)?.read_raw::<f64>();
+    let data = |name: &str| open_dataset(&group, name)?.read_raw::<f64>();
     let basis = if group.link_exists(BASIS) {
         Some(read_basis(&group.group(BASIS)?)?)
     } else {
@@ -151,14 +151,14 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ReconstructionRecord>> {
 }
 
 fn read_basis(group: &Group) -> hdf5::Result<BasisRecord> {
-    let data = |name: &str| group.dataset(name)?.read_raw::<f64>();
+    let data = |name: &str| open_dataset(group, name)?.read_raw::<f64>();
     let norms = data("norms")?;
     Ok(BasisRecord {
         centre: read_f64(group, "centre")?,
         terms: norms.len(),
         coefficients: data("coefficients")?,
         norms,
-        kept: group.dataset("kept")?.read_raw::<i64>()?,
+        kept: open_dataset(group, "kept")?.read_raw::<i64>()?,
         data_weight: data("data_weight")?,
         data_p: data("data_p")?,
         curve_p: data("curve_p")?,

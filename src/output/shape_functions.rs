@@ -6,7 +6,7 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{read_f64, read_i64, read_str};
+use super::reader::{open_dataset, read_f64, read_i64, read_str};
 use super::writer::{attr_f64, attr_i64, attr_str, dataset};
 use super::SHAPE_FIELDS;
 
@@ -104,8 +104,8 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ShapeFunctionRecord>> {
         return Ok(None);
     }
     let group: Group = file.group(GROUP)?;
-    let real = |name: &str| group.dataset(name)?.read_raw::<f64>();
-    let x = group.dataset("x")?;
+    let real = |name: &str| open_dataset(&group, name)?.read_raw::<f64>();
+    let x = open_dataset(&group, "x")?;
     let mut errors: [Vec<f64>; 4] = Default::default();
     let mut max_errors = [f64::NAN; 4];
     for (f, field) in SHAPE_FIELDS.iter().enumerate() {
@@ -119,7 +119,7 @@ pub(super) fn read(file: &File) -> hdf5::Result<Option<ShapeFunctionRecord>> {
         tolerance: read_f64(&group, "tolerance")?,
         radius: read_f64(&group, "radius")?,
         x: x.read_raw::<f64>()?,
-        nodes: group.dataset("nodes")?.read_raw::<i64>()?,
+        nodes: open_dataset(&group, "nodes")?.read_raw::<i64>()?,
         centre: read_i64(&group, "centre")?,
         node_x: real("node_x")?,
         value: real("value")?,

@@ -19,6 +19,15 @@ pub struct Indexed<'a> {
     pub claims: Vec<Outcome<'a>>,
     pub figures: Vec<Figure>,
     pub maps: Vec<FieldMap>,
+    /// How many of its run files its report could not read (and lists).
+    pub unreadable_runs: usize,
+}
+
+/// A results directory the index leaves out: its experiment copy cannot be read, or its
+/// report cannot be planned.
+pub struct Unreadable<'a> {
+    pub dir: &'a str,
+    pub reason: String,
 }
 
 const VERDICTS: [Verdict; 5] = [
@@ -29,7 +38,7 @@ const VERDICTS: [Verdict; 5] = [
     Verdict::Unmeasured,
 ];
 
-pub fn index_md(experiments: &[Indexed]) -> String {
+pub fn index_md(experiments: &[Indexed], unreadable: &[Unreadable]) -> String {
     let mut md = String::from(
         "# Reproduction index\n\nWritten by `mpmlab index` (`make all`) from `experiments/*.yaml` \
          and the run files: every number a paper states (each experiment's `paper_claims`), \
@@ -49,13 +58,23 @@ pub fn index_md(experiments: &[Indexed]) -> String {
     figures_by_item(&mut md, experiments);
     md.push_str("## Experiments\n\n");
     for e in experiments {
-        let _ = writeln!(
+        let _ = write!(
             md,
             "- [{}]({}/report.md): {} runs",
             e.experiment.name,
             e.dir,
             e.experiment.runs.len()
         );
+        let _ = match e.unreadable_runs {
+            0 => writeln!(md),
+            n => writeln!(md, "; {n} unreadable run file(s), listed in its report"),
+        };
+    }
+    if !unreadable.is_empty() {
+        md.push_str("\n## Unreadable results directories\n\nLeft out of everything above:\n\n");
+        for u in unreadable {
+            let _ = writeln!(md, "- `{}`: {}", u.dir, u.reason.replace('\n', " "));
+        }
     }
     md
 }

@@ -12,7 +12,7 @@ use plotters::style::FontStyle;
 
 use super::figures::{FieldMap, Panel};
 use super::fit::min_max;
-use super::plot::{caption_size, linear_tick_label, register_fonts, FONT};
+use super::plot::{caption_size, linear_tick_label, png, register_fonts, FONT};
 
 /// The plotting area of a panel along the longer side of the domain, in pixels.
 const PANEL_SIDE: u32 = 300;
@@ -41,9 +41,10 @@ const TICKS: usize = 6;
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
-pub fn render(path: &Path, map: &FieldMap) -> io::Result<()> {
+/// Draws `map` as the bytes of a PNG, which `path` names in errors.
+pub fn render(path: &Path, map: &FieldMap) -> io::Result<Vec<u8>> {
     register_fonts();
-    draw(path, map).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
+    draw(map).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
 }
 
 /// The extent of the data every panel shares, and the size of one panel's plotting area.
@@ -102,7 +103,7 @@ fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn draw(path: &Path, map: &FieldMap) -> DrawResult {
+fn draw(map: &FieldMap) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     let layout = Layout::of(map);
     let (panel_w, panel_h) = layout.panel();
     let caption = Layout::caption_height(map);
@@ -115,32 +116,34 @@ fn draw(path: &Path, map: &FieldMap) -> DrawResult {
     let width = (content + 2 * MARGIN).max(MIN_WIDTH);
     let left = (width - content) / 2;
     let height = MARGIN + caption + layout.rows as u32 * panel_h + legend + MARGIN / 2;
-    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
-    root.fill(&WHITE)?;
-    draw_caption(&root, map, width)?;
-    let top = (MARGIN + caption) as i32;
-    for (i, panel) in map.panels.iter().enumerate() {
-        let (column, row) = ((i % layout.columns) as u32, (i / layout.columns) as u32);
-        let x0 = (left + column * panel_w) as i32;
-        let y0 = top + (row * panel_h) as i32;
-        let area = root.clone().shrink((x0, y0), (panel_w, panel_h));
-        draw_panel(&area, map, panel, &layout)?;
-    }
-    // The bar runs from the top of the first row's axes to the bottom of the last row's.
-    let bar_top = top + (PANEL_LABEL + PANEL_MARGIN) as i32;
-    let bar_height = layout.rows as u32 * panel_h - PANEL_LABEL - X_LABEL_AREA - 2 * PANEL_MARGIN;
-    let bar_left = (left + layout.columns as u32 * panel_w) as i32;
-    let bar = root.clone().shrink(
-        (bar_left, bar_top),
-        (BAR_WIDTH + BAR_LABEL_AREA, bar_height),
-    );
-    draw_colour_bar(&bar, map)?;
-    if legend > 0 {
-        let y = top + (layout.rows as u32 * panel_h) as i32 + (LEGEND_ROW / 2) as i32;
-        draw_legend(&root, map, (left + Y_LABEL_AREA + PANEL_MARGIN) as i32, y)?;
-    }
-    root.present()?;
-    Ok(())
+    png((width, height), |root| {
+        root.fill(&WHITE)?;
+        draw_caption(&root, map, width)?;
+        let top = (MARGIN + caption) as i32;
+        for (i, panel) in map.panels.iter().enumerate() {
+            let (column, row) = ((i % layout.columns) as u32, (i / layout.columns) as u32);
+            let x0 = (left + column * panel_w) as i32;
+            let y0 = top + (row * panel_h) as i32;
+            let area = root.clone().shrink((x0, y0), (panel_w, panel_h));
+            draw_panel(&area, map, panel, &layout)?;
+        }
+        // The bar runs from the top of the first row's axes to the bottom of the last row's.
+        let bar_top = top + (PANEL_LABEL + PANEL_MARGIN) as i32;
+        let bar_height =
+            layout.rows as u32 * panel_h - PANEL_LABEL - X_LABEL_AREA - 2 * PANEL_MARGIN;
+        let bar_left = (left + layout.columns as u32 * panel_w) as i32;
+        let bar = root.clone().shrink(
+            (bar_left, bar_top),
+            (BAR_WIDTH + BAR_LABEL_AREA, bar_height),
+        );
+        draw_colour_bar(&bar, map)?;
+        if legend > 0 {
+            let y = top + (layout.rows as u32 * panel_h) as i32 + (LEGEND_ROW / 2) as i32;
+            draw_legend(&root, map, (left + Y_LABEL_AREA + PANEL_MARGIN) as i32, y)?;
+        }
+        root.present()?;
+        Ok(())
+    })
 }
 
 /// The title in bold, each line shrunk to fit the width, and the group below it.

@@ -12,15 +12,16 @@ use super::pointwise::Table;
 use super::RateRow;
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::Experiment;
-use crate::output::{RunStatus, RunSummary, REFERENCE_NORM, SHAPE_FIELDS};
+use crate::output::{RunStatus, RunSummary, UnreadableRun, REFERENCE_NORM, SHAPE_FIELDS};
 
 /// What the report computed besides the rates: its tables, figures, field maps and the
-/// papers' claims against ours.
+/// papers' claims against ours; and the run files it could not read.
 pub struct Contents<'a> {
     pub tables: &'a [Table],
     pub figures: &'a [Figure],
     pub maps: &'a [FieldMap],
     pub claims: &'a [Outcome<'a>],
+    pub unreadable: &'a [UnreadableRun],
 }
 
 pub fn report_md(
@@ -35,6 +36,7 @@ pub fn report_md(
         figures,
         maps,
         claims,
+        unreadable,
     } = *contents;
     let runs = ordered_runs(runs);
     let mut md = format!("# {}\n\n", experiment.name);
@@ -50,6 +52,7 @@ pub fn report_md(
         rates_table(&mut md, rates);
     }
     unfinished(&mut md, experiment, &runs);
+    unreadable_files(&mut md, unreadable);
     claims_table(&mut md, claims, figures);
     if !tables.is_empty() {
         md.push_str("## Tables\n\n");
@@ -227,6 +230,24 @@ fn rates_table(md: &mut String, rates: &[RateRow]) {
         ]
     });
     table(md, &header, rows);
+}
+
+/// The run files the report could not read, so that it is plain which runs its tables,
+/// rates and figures lack.
+fn unreadable_files(md: &mut String, files: &[UnreadableRun]) {
+    if files.is_empty() {
+        return;
+    }
+    md.push_str(
+        "## Unreadable run files\n\nThese files in `runs/` could not be read; the tables, rates \
+         and figures leave them out, and `mpmlab report --check` fails while they are there. \
+         Remove them and `mpmlab run` computes the runs whose file is missing.\n\n",
+    );
+    let rows = files.iter().map(|f| {
+        let name = f.file.to_string_lossy().replace('\\', "/");
+        vec![format!("`{name}`"), f.reason.clone()]
+    });
+    table(md, &["file".into(), "reason".into()], rows);
 }
 
 /// Diverged and failed runs are left out of fits and convergence figures; this says which

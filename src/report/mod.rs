@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 pub use check::{check, CheckFailure};
 
 use crate::experiment::Experiment;
-use crate::output::RunSummary;
+use crate::output::{remove_dead_temps, write_all_atomically, RunSummary, UnreadableRun};
 use crate::params::Params;
 
 /// The fitted convergence rate of one (group, field, norm): `log10(error) = intercept +
@@ -63,12 +63,18 @@ pub struct Report {
 }
 
 /// Writes summary.csv, timings.csv, rates.csv, figures/*.png (plots, then field maps) with
-/// their data figures/*.csv, and report.md into `dir`;
-/// report.md gets a "Checks" section when `check` is given.
+/// their data figures/*.csv, and report.md into `dir`; report.md lists the `unreadable` run
+/// files, and gets a "Checks" section when `check` is given.
+///
+/// Every file is computed before any is written, then all are written under temporary names
+/// and renamed into place (`output::write_all_atomically`): an error on the way, a full disk
+/// included, leaves the previous report as it was. The figures of an earlier report that
+/// this one no longer draws are removed last.
 pub fn write_report(
     dir: &Path,
     experiment: &Experiment,
     runs: &[RunSummary],
+    unreadable: &[UnreadableRun],
     rates: &[RateRow],
     check: Option<&[CheckFailure]>,
 ) -> io::Result<Report> {
@@ -77,27 +83,18 @@ pub fn write_report(
     let tables = pointwise::tables(experiment, runs).map_err(io::Error::other)?;
     let figure_dir = dir.join("figures");
     fs::create_dir_all(&figure_dir)?;
-    let files: Vec<PathBuf> = figures
-        .iter()
-        .map(|f| f.file.clone())
-        .chain(maps.iter().map(|m| m.file.clone()))
-        .collect();
-    remove_stale_figures(&figure_dir, &files)?;
-    fs::write(
-        dir.join("summary.csv"),
-        tables::summary_csv(experiment, runs),
-    )?;
-    fs::write(dir.join("timings.csv"), tables::timings_csv(runs))?;
-    fs::write(dir.join("rates.csv"), tables::rates_csv(rates))?;
+    remove_dead_temps(dir)?;
+    remove_dead_temps(&figure_dir)?;
+    let mut outputs: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     for figure in &figures {
         let png = dir.join(&figure.file);
-        plot::render(&png, figure)?;
-        fs::write(png.with_extension("csv"), tables::figure_csv(figure))?;
+        outputs.push((png.clone(), plot::render(&png, figure)?));
+        outputs.push((png.with_extension("csv"), tables::figure_csv(figure).into()));
     }
     for map in &maps {
         let png = dir.join(&map.file);
-        map_plot::render(&png, map)?;
-        fs::write(png.with_extension("csv"), tables::map_csv(map))?;
+        outputs.push((png.clone(), map_plot::render(&png, map)?));
+        outputs.push((png.with_extension("csv"), tables::map_csv(map).into()));
     }
     let claims = claims::evaluate(experiment, rates, runs);
     let contents = markdown::Contents {
@@ -105,9 +102,25 @@ pub fn write_report(
         figures: &figures,
         maps: &maps,
         claims: &claims,
+        unreadable,
     };
     let md = markdown::report_md(experiment, runs, rates, &contents, check);
-    fs::write(dir.join("report.md"), md)?;
+    outputs.extend([
+        (
+            dir.join("summary.csv"),
+            tables::summary_csv(experiment, runs).into(),
+        ),
+        (dir.join("timings.csv"), tables::timings_csv(runs).into()),
+        (dir.join("rates.csv"), tables::rates_csv(rates).into()),
+        (dir.join("report.md"), md.into()),
+    ]);
+    write_all_atomically(&outputs)?;
+    let files: Vec<PathBuf> = figures
+        .iter()
+        .map(|f| f.file.clone())
+        .chain(maps.iter().map(|m| m.file.clone()))
+        .collect();
+    remove_stale_figures(&figure_dir, &files)?;
     Ok(Report { figures: files })
 }
 

@@ -6,6 +6,8 @@ use std::io;
 use std::path::Path;
 use std::sync::Once;
 
+use image::codecs::png::PngEncoder;
+use image::{ColorType, ImageEncoder};
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -64,17 +66,31 @@ pub(super) fn register_fonts() {
     });
 }
 
-/// Writes `figure` as a PNG: each series' markers and its line in the style `style` gives it,
-/// with the legend below the axes so it never hides data.
-pub fn render(path: &Path, figure: &Figure) -> io::Result<()> {
+/// Draws `figure` as the bytes of a PNG, which `path` names in errors: each series' markers
+/// and its line in the style `style` gives it, with the legend below the axes so it never
+/// hides data.
+pub fn render(path: &Path, figure: &Figure) -> io::Result<Vec<u8>> {
     register_fonts();
-    draw(path, figure).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
+    draw(figure).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
-fn draw(path: &Path, figure: &Figure) -> DrawResult {
+/// An RGB image of `size` drawn by `draw` into memory, encoded as PNG as plotters would write
+/// it to a file; the report writes it under a temporary name (`write_report`).
+pub(super) fn png(
+    size: (u32, u32),
+    draw: impl FnOnce(Area) -> DrawResult,
+) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
+    let mut pixels = vec![0; 3 * size.0 as usize * size.1 as usize];
+    draw(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area())?;
+    let mut png = Vec::new();
+    PngEncoder::new(&mut png).write_image(&pixels, size.0, size.1, ColorType::Rgb8)?;
+    Ok(png)
+}
+
+fn draw(figure: &Figure) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     let columns = legend_columns(figure);
     let rows = figure.series.len().div_ceil(columns) as u32;
     let notes: Vec<String> = figure
@@ -84,16 +100,17 @@ fn draw(path: &Path, figure: &Figure) -> DrawResult {
         .collect();
     let legend_height = rows * LEGEND_ROW;
     let height = AXES_HEIGHT + legend_height + notes.len() as u32 * NOTE_ROW + MARGIN / 2;
-    let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (axes, below) = root.split_vertically(AXES_HEIGHT);
-    let (legend, note_area) = below.split_vertically(legend_height);
-    let styles = style::assign(&figure.series);
-    draw_axes(&axes, figure, &styles)?;
-    draw_legend(&legend, figure, &styles, columns)?;
-    draw_notes(&note_area, &notes)?;
-    root.present()?;
-    Ok(())
+    png((WIDTH, height), |root| {
+        root.fill(&WHITE)?;
+        let (axes, below) = root.split_vertically(AXES_HEIGHT);
+        let (legend, note_area) = below.split_vertically(legend_height);
+        let styles = style::assign(&figure.series);
+        draw_axes(&axes, figure, &styles)?;
+        draw_legend(&legend, figure, &styles, columns)?;
+        draw_notes(&note_area, &notes)?;
+        root.present()?;
+        Ok(())
+    })
 }
 
 fn draw_axes(area: &Area, figure: &Figure, styles: &[Style]) -> DrawResult {

@@ -127,8 +127,9 @@ def test_run_files_present():
 
 def test_no_leftover_files_in_runs_dirs():
     """Run files and their XDMF descriptions are written under a temporary name and renamed
-    when complete, so a finished `mpmlab run` leaves nothing but <run_id>.h5 and
-    <run_id>.xdmf in each runs/ directory."""
+    when complete, and each run's lock file goes when its run is written, so a finished
+    `mpmlab run` leaves nothing but <run_id>.h5, <run_id>.xdmf and the record of the
+    experiment file (.experiment-source) in each runs/ directory."""
     root = _results_root()
     if root is None or not root.is_dir():
         pytest.fail(f"{ENV} is not set or not a directory")
@@ -137,7 +138,7 @@ def test_no_leftover_files_in_runs_dirs():
         for runs in root.rglob("runs")
         if runs.is_dir()
         for p in runs.iterdir()
-        if not (p.is_file() and p.suffix in (".h5", ".xdmf"))
+        if not (p.is_file() and (p.suffix in (".h5", ".xdmf") or p.name == ".experiment-source"))
     ]
     assert not stray, f"unexpected entries in runs/ directories: {stray}"
 
