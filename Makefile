@@ -12,12 +12,15 @@
 #   make reproduce  every experiment from scratch into target/reproduce, compared byte for
 #                   byte with the committed results/ (part of make test)
 #   make bench      particle-steps per second per method and dimension
+#   make fuzz       mutation fuzzing of the experiment front end and of `run` on tiny
+#                   problems for FUZZ_SECONDS (default 300); findings in target/fuzz/findings/
 #   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
 #   make clean-results   delete generated HDF5 run files and their XDMF descriptions
 #                   (reports and figures stay)
 #
 # Variables: JOBS=N (parallel runs, default: all cores), FORCE=1 (re-run complete runs),
-# RESULTS=DIR (output of `make all`, default results), PYTHON=python3 (to create .venv).
+# RESULTS=DIR (output of `make all`, default results), PYTHON=python3 (to create .venv),
+# FUZZ_SECONDS=S and FUZZ_SEED=N (make fuzz; the seed defaults to the clock).
 #
 # Convention: an experiment file's stem equals its `name:` (experiments/foo.yaml has
 # `name: foo`), because its results go to results/<name>/. The recipes check this.
@@ -40,6 +43,8 @@ PYTHON ?= python3
 RESULTS ?= results
 JOBS ?=
 FORCE ?=
+FUZZ_SECONDS ?= 300
+FUZZ_SEED ?=
 
 # cargo builds into $CARGO_TARGET_DIR when it is set.
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/mpmlab
@@ -57,7 +62,7 @@ RUN_FLAGS = $(if $(JOBS),--jobs $(JOBS)) $(if $(FORCE),--force)
 # die, step, apt_install, check_stems
 SH_LIB := source scripts/lib.sh
 
-.PHONY: all deps deps-system deps-python build lint test test-slurm reproduce bench clean-results
+.PHONY: all deps deps-system deps-python build lint test test-slurm reproduce bench fuzz clean-results
 
 all: deps build
 	@$(SH_LIB)
@@ -167,6 +172,14 @@ bench: deps-system
 	@$(SH_LIB)
 	step "$(CARGO) bench --bench throughput"
 	$(CARGO) bench --bench throughput
+
+# Open-ended: `make test` replays a fixed set of mutants and the kept findings instead
+# (tests/front_end_fuzz.rs).
+fuzz: deps-system
+	@$(SH_LIB)
+	step "cargo test --test front_end_fuzz fuzz_open_ended ($(FUZZ_SECONDS) s)"
+	MPMLAB_FUZZ_SECONDS=$(FUZZ_SECONDS) $(if $(FUZZ_SEED),MPMLAB_FUZZ_SEED=$(FUZZ_SEED)) \
+	  $(CARGO) test --release --test front_end_fuzz fuzz_open_ended -- --ignored --nocapture
 
 clean-results:
 	@$(SH_LIB)
