@@ -9,7 +9,7 @@ use std::process::{Command, Stdio};
 
 use mpmlab::benchmarks::{self, AnyProblem, MAX_POINTS, MAX_STEPS};
 use mpmlab::experiment::{
-    self, ConfigError, Experiment, MAX_LIST_VALUES, MAX_RUN_ID_LEN, MAX_SAMPLES,
+    self, ConfigError, Experiment, MAX_LIST_VALUES, MAX_NAME_LEN, MAX_RUN_ID_LEN, MAX_SAMPLES,
 };
 use mpmlab::params::ParamValue;
 use mpmlab::shape::MAX_STENCIL_NODES;
@@ -46,6 +46,17 @@ fn refused(name: &str, line: usize, column: usize, field: &str, said: &[&str]) -
 
 fn max_steps() -> String {
     format!("more than max_steps = {MAX_STEPS}")
+}
+
+#[test]
+fn a_name_longer_than_a_directory_name_is_refused() {
+    refused(
+        "name_too_long.yaml",
+        3,
+        7,
+        "name",
+        &["a name of 300 bytes", &format!("at most {MAX_NAME_LEN}")],
+    );
 }
 
 #[test]

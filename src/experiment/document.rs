@@ -64,9 +64,23 @@ impl<'a> Sections<'a> {
 }
 
 /// The experiment name; it becomes a directory name, hence the restricted alphabet.
+/// The longest experiment `name`, in bytes: it names the results directory, whose name a
+/// file system limits (to 255 bytes on most).
+pub const MAX_NAME_LEN: usize = 100;
+
 pub(crate) fn name(sections: &Sections) -> Result<String, ConfigError> {
     let node = sections.require("name")?.value;
     let name = node.as_text("name")?;
+    if name.len() > MAX_NAME_LEN {
+        return Err(ConfigError::at(
+            node.pos,
+            "name",
+            format!(
+                "a name of {} bytes cannot be a directory name; at most {MAX_NAME_LEN}",
+                name.len()
+            ),
+        ));
+    }
     let allowed = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
     if name.is_empty() || !name.chars().all(allowed) {
         return Err(ConfigError::at(

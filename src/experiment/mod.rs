@@ -25,6 +25,7 @@ use crate::benchmarks::{self, BenchmarkKind};
 use crate::output::Measures;
 use crate::params::Params;
 
+pub use document::MAX_NAME_LEN;
 pub use error::ConfigError;
 pub use expand::{MAX_RUNS, MAX_SAMPLES};
 pub use run_id::MAX_RUN_ID_LEN;

@@ -63,8 +63,11 @@ pub fn write_atomically(
 /// of them leaves the set part new, part old.
 pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> io::Result<()> {
     let mut staged = Vec::with_capacity(files.len());
+    let naming = |path: &Path| {
+        let path = path.display().to_string();
+        move |e: io::Error| io::Error::new(e.kind(), format!("{path}: {e}"))
+    };
     let written = files.iter().try_for_each(|(path, contents)| {
-        let in_words = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         // rename(2) cannot replace a directory, and would fail half way through the set.
         if path.is_dir() {
             return Err(io::Error::other(format!(
@@ -74,13 +77,13 @@ pub fn write_all_atomically(files: &[(PathBuf, Vec<u8>)]) -> io::Result<()> {
         }
         let tmp = temp_path(path);
         staged.push(tmp.clone());
-        write_synced(&tmp, contents).map_err(in_words)
+        write_synced(&tmp, contents).map_err(naming(path))
     });
     let renamed = written.and_then(|()| {
-        files.iter().zip(&staged).try_for_each(|((path, _), tmp)| {
-            fs::rename(tmp, path)
-                .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))
-        })
+        files
+            .iter()
+            .zip(&staged)
+            .try_for_each(|((path, _), tmp)| fs::rename(tmp, path).map_err(naming(path)))
     });
     if renamed.is_err() {
         for tmp in &staged {
