@@ -11,7 +11,9 @@ use mpmlab::benchmarks::{self, AnyProblem, MAX_POINTS, MAX_STEPS};
 use mpmlab::experiment::{
     self, ConfigError, Experiment, MAX_LIST_VALUES, MAX_NAME_LEN, MAX_RUN_ID_LEN, MAX_SAMPLES,
 };
+use mpmlab::output::{open_run_file, read_summary, run_path};
 use mpmlab::params::ParamValue;
+use mpmlab::runner::{results_dir, run_experiment, RunOptions};
 use mpmlab::shape::MAX_STENCIL_NODES;
 
 const DIR: &str = "tests/inputs/robustness";
@@ -240,16 +242,38 @@ fn points_axis(n: usize) -> String {
     )
 }
 
+/// ... and is written: its configuration (about 400 kB of YAML) and its list are datasets,
+/// which an attribute of at most 64 KiB could not hold, and read back whole.
 #[test]
-fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id() {
+fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {
     let text = points_axis(20_000);
-    let runs = experiment::parse(&text, Path::new("many_points.yaml"))
-        .unwrap()
-        .runs;
-    let id = &runs[0].run_id;
+    let experiment = experiment::parse(&text, Path::new("many_points.yaml")).unwrap();
+    let run = &experiment.runs[0];
+    let id = &run.run_id;
     assert!(id.starts_with("imls_quadratic-pointslist20000-"), "{id}");
     assert!(fits(id), "{id}");
-    assert_eq!(runs[0].params["points"].as_list().unwrap().len(), 20_000);
+    assert_eq!(run.params["points"].as_list().unwrap().len(), 20_000);
+    assert!(run.config_yaml.len() > 1 << 16, "{}", run.config_yaml.len());
+
+    let out = tempfile::tempdir().unwrap();
+    let options = RunOptions {
+        out: out.path().to_path_buf(),
+        jobs: 1,
+        force: false,
+    };
+    let outcome = run_experiment(&experiment, &options).unwrap();
+    assert_eq!(
+        (outcome.written, outcome.failed.len()),
+        (1, 0),
+        "{outcome:?}"
+    );
+    let dir = results_dir(out.path(), &experiment);
+    let file = open_run_file(&run_path(&dir, id)).unwrap();
+    let summary = read_summary(&file).unwrap();
+    assert_eq!(summary.axes["points"], run.params["points"]);
+    let stored: hdf5::types::VarLenUnicode =
+        file.dataset("config_yaml").unwrap().read_scalar().unwrap();
+    assert_eq!(stored.as_str(), run.config_yaml);
 }
 
 #[test]

@@ -7,7 +7,10 @@ use crate::benchmarks::{self, BenchmarkInfo, BenchmarkKind};
 use crate::params::Params;
 
 /// Bumped whenever a name or shape below changes meaning.
-pub const SCHEMA_VERSION: i64 = 2;
+pub const SCHEMA_VERSION: i64 = 3;
+
+/// The root dataset holding the run's resolved configuration as YAML text.
+pub const CONFIG_YAML: &str = "config_yaml";
 
 /// The error fields at the particles, in the order they are written.
 pub const ERROR_FIELDS: [&str; 4] = ["displacement", "velocity", "stress", "density"];

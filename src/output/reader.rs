@@ -301,20 +301,22 @@ fn unstepped_norms(fields: &[&str], norms: &[&str], values: &[f64]) -> FinalNorm
         .collect()
 }
 
-/// Attributes of a group as parameter values, typed as they were written.
-fn read_params(loc: &Location) -> hdf5::Result<Params> {
+/// The parameter values of a group, typed as they were written: scalars as its attributes,
+/// lists as its datasets.
+fn read_params(group: &Group) -> hdf5::Result<Params> {
     let mut params = Params::new();
-    for name in loc.attr_names()? {
-        let attr = open_attr(loc, &name)?;
+    for name in group.attr_names()? {
+        let attr = open_attr(group, &name)?;
         let value = match attr.dtype()?.to_descriptor()? {
-            TypeDescriptor::Integer(_) => ParamValue::Int(read_i64(loc, &name)?),
-            TypeDescriptor::Float(_) if attr.is_scalar() => {
-                ParamValue::Float(read_f64(loc, &name)?)
-            }
-            TypeDescriptor::Float(_) => ParamValue::List(attr.read_raw::<f64>()?),
-            _ => ParamValue::Str(read_str(loc, &name)?),
+            TypeDescriptor::Integer(_) => ParamValue::Int(read_i64(group, &name)?),
+            TypeDescriptor::Float(_) => ParamValue::Float(read_f64(group, &name)?),
+            _ => ParamValue::Str(read_str(group, &name)?),
         };
         params.insert(name, value);
+    }
+    for name in group.member_names()? {
+        let values = open_dataset(group, &name)?.read_raw::<f64>()?;
+        params.insert(name, ParamValue::List(values));
     }
     Ok(params)
 }

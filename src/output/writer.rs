@@ -5,8 +5,8 @@ use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
 use super::{
-    elements, probes, reconstruction, shape_functions, RunRecord, ERROR_FIELDS, GRID_VELOCITY,
-    SCHEMA_VERSION,
+    elements, probes, reconstruction, shape_functions, RunRecord, CONFIG_YAML, ERROR_FIELDS,
+    GRID_VELOCITY, SCHEMA_VERSION,
 };
 use crate::params::ParamValue;
 
@@ -127,24 +127,24 @@ fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
         ("method", &r.spec.method),
         ("status", r.status.as_str()),
         ("message", &r.message),
-        ("config_yaml", &r.spec.config_yaml),
         ("mpmlab_version", env!("CARGO_PKG_VERSION")),
     ] {
         attr_str(file, name, value)?;
     }
+    // A dataset, since an attribute holds at most 64 KiB and a configuration with long lists
+    // is longer.
+    string_dataset(file, CONFIG_YAML, &r.spec.config_yaml)?;
     for (name, value) in [("dim", r.dim), ("cells", r.cells), ("ppc", r.ppc)] {
         attr_i64(file, name, value as i64)?;
     }
     for (name, value) in [("h", r.h), ("wall_seconds", r.wall_seconds)] {
         attr_f64(file, name, value)?;
     }
-    let params = file.create_group("params")?;
-    for (key, value) in &r.spec.params {
-        attr_param(&params, key, value)?;
-    }
-    let matrix = file.create_group("matrix")?;
-    for (key, value) in &r.spec.axes {
-        attr_param(&matrix, key, value)?;
+    for (name, values) in [("params", &r.spec.params), ("matrix", &r.spec.axes)] {
+        let group = file.create_group(name)?;
+        for (key, value) in values {
+            write_param(&group, key, value)?;
+        }
     }
     Ok(())
 }
@@ -175,27 +175,40 @@ pub(super) fn dataset<T: H5Type>(
     attr_str(&ds, "units", unit)
 }
 
-fn attr_param(loc: &Location, key: &str, value: &ParamValue) -> hdf5::Result<()> {
+/// A scalar parameter as an attribute of `group`, a list as a dataset in it (of any length,
+/// which an attribute is not).
+fn write_param(group: &Group, key: &str, value: &ParamValue) -> hdf5::Result<()> {
     match value {
-        ParamValue::Int(i) => attr_i64(loc, key, *i),
-        ParamValue::Float(x) => attr_f64(loc, key, *x),
-        ParamValue::Str(s) => attr_str(loc, key, s),
-        ParamValue::List(values) => loc
-            .new_attr::<f64>()
+        ParamValue::Int(i) => attr_i64(group, key, *i),
+        ParamValue::Float(x) => attr_f64(group, key, *x),
+        ParamValue::Str(s) => attr_str(group, key, s),
+        ParamValue::List(values) => group
+            .new_dataset::<f64>()
             .shape(values.len())
             .create(key)?
             .write_raw(values),
     }
 }
 
-pub(super) fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
-    let value: VarLenUnicode = value
+fn string_dataset(group: &Group, name: &str, value: &str) -> hdf5::Result<()> {
+    group
+        .new_dataset::<VarLenUnicode>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&to_unicode(name, value)?)
+}
+
+fn to_unicode(name: &str, value: &str) -> hdf5::Result<VarLenUnicode> {
+    value
         .parse()
-        .map_err(|e| hdf5::Error::from(format!("attribute {name}: {e}")))?;
+        .map_err(|e| hdf5::Error::from(format!("{name}: {e}")))
+}
+
+pub(super) fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
     loc.new_attr::<VarLenUnicode>()
         .shape(())
         .create(name)?
-        .write_scalar(&value)
+        .write_scalar(&to_unicode(name, value)?)
 }
 
 pub(super) fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {

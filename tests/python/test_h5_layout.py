@@ -46,7 +46,7 @@ import numpy as np
 import pytest
 
 ENV = "MPMLAB_RESULTS"
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 STR_ATTRS = (
     "run_id",
@@ -55,7 +55,6 @@ STR_ATTRS = (
     "method",
     "status",
     "message",
-    "config_yaml",
     "mpmlab_version",
 )
 INT_ATTRS = ("schema_version", "dim", "cells", "ppc")
@@ -230,8 +229,17 @@ class Run:
         if not self.is_shape_functions:
             pytest.skip("no /shape_functions group")
 
+    def values(self, name):
+        """A group's parameter values: its attributes (scalars) and its datasets (lists)."""
+        values = dict(self.group(name))
+        for key, value in self.data.items():
+            parent, _, leaf = key.rpartition("/")
+            if parent == name:
+                values[leaf] = value
+        return values
+
     def param(self, key):
-        params = self.group("/params")
+        params = self.values("/params")
         assert key in params, f"/params has no attribute {key}"
         value = params[key]
         assert np.asarray(value).shape == (), f"/params/{key} is not a scalar"
@@ -280,7 +288,7 @@ def test_root_attributes(run):
     assert a["status"] in STATUSES, f"status {a['status']!r} not in {STATUSES}"
     if a["status"] == "diverged":
         assert a["message"].strip(), "a diverged run must say where and why in `message`"
-    for name in ("run_id", "experiment", "benchmark", "method", "config_yaml", "mpmlab_version"):
+    for name in ("run_id", "experiment", "benchmark", "method", "mpmlab_version"):
         assert a[name].strip(), f"{name} is empty"
     assert a["dim"] in (1, 2, 3)
     assert a["cells"] >= 1 and a["h"] > 0 and a["wall_seconds"] >= 0
@@ -312,11 +320,25 @@ def test_identity(run):
         assert a["dim"] == bench.dim, f"{a['benchmark']} has dim {bench.dim}"
 
 
+def test_config_yaml_dataset(run):
+    """The resolved configuration is a scalar string dataset (an attribute cannot hold a long
+    one), the YAML of the run's experiment and benchmark."""
+    assert "config_yaml" not in run.attrs, "config_yaml is a dataset, not a root attribute"
+    text = _as_str(run.ds("/config_yaml"))
+    assert isinstance(text, str), f"/config_yaml is not a string: {text!r}"
+    lines = text.splitlines()
+    assert f"experiment: {run.attrs['experiment']}" in lines, lines[:3]
+    assert f"benchmark: {run.attrs['benchmark']}" in lines, lines[:3]
+
+
 def test_params_and_matrix(run):
     a = run.attrs
-    params = run.group("/params")
-    matrix = run.group("/matrix")
-    assert params, "/params has no attributes"
+    for name in ("/params", "/matrix"):
+        for key, value in run.group(name).items():
+            assert np.asarray(value).ndim == 0, f"{name} attribute {key} is not a scalar"
+    params = run.values("/params")
+    matrix = run.values("/matrix")
+    assert params, "/params has no values"
     bench = BENCHMARKS.get(a["benchmark"])
     if bench is not None:
         for key in bench.params + ("rho0", "t_end", "ppc", "cells"):
@@ -327,7 +349,7 @@ def test_params_and_matrix(run):
         np.testing.assert_allclose(a["h"], bench.length(run) / a["cells"], rtol=RTOL_STORED)
         assert a["dt"] <= bench.max_dt(run) * (1 + 1e-9), "dt exceeds the requested step"
     for key, value in matrix.items():
-        # Scalars, or 1-D float arrays for list-valued parameters (point coordinates).
+        # Scalars, or 1-D float datasets for list-valued parameters (point coordinates).
         assert np.asarray(value).ndim <= 1, f"/matrix/{key} is neither a scalar nor a list"
         if key == "method":
             assert value == a["method"], f"/matrix method {value!r} != root method"
@@ -398,6 +420,9 @@ def test_datasets_shapes_types_units(run):
         else:
             assert arr.dtype == np.float64, f"{name} dtype {arr.dtype} is not float64"
     for name, units in run.units.items():
+        # The configuration and list-valued parameters are inputs, not physical arrays.
+        if name == "/config_yaml" or name.startswith(("/params/", "/matrix/")):
+            continue
         assert isinstance(units, str), f"dataset {name} has no string `units` attribute"
     n_p = shapes["/particles/X"][0]
     assert n_p >= 1
@@ -632,7 +657,7 @@ def test_grid_time(run):
     a = run.attrs
     if a["method"] in REFERENCE_METHODS:
         pytest.skip("a reference solver has no grid")
-    sampled = run.group("/params").get("sampled_velocity", "stepped")
+    sampled = run.values("/params").get("sampled_velocity", "stepped")
     integrator = str(a["integrator"])
     half = integrator in HALF_STEP_INTEGRATORS or (
         integrator in CENTRED_INTEGRATORS and sampled == "centred"
@@ -893,7 +918,7 @@ def cell_fractions(spacing, c, n, rng):
 
 
 def expected_points(run):
-    p = run.group("/params")
+    p = run.values("/params")
     if run.attrs["benchmark"] == "recon1d_basis":
         return np.asarray(p["points"], dtype=float)
     lower, upper, cells, ppc = p["lower"], p["upper"], int(p["cells"]), int(p["ppc"])
@@ -949,7 +974,7 @@ def test_reconstruction_data_and_norms(run):
     run.require_reconstruction()
     if run.status == "failed" and run.ds("/reconstruction/x").size == 0:
         pytest.skip("failed run without a grid")
-    a, p, g = run.attrs, run.group("/params"), run.group("/reconstruction")
+    a, p, g = run.attrs, run.values("/params"), run.group("/reconstruction")
     f = FUNCTIONS[p["function"]]
     x = run.ds("/reconstruction/x")
     lower, upper, h = p["lower"], p["upper"], a["h"]
@@ -1108,7 +1133,7 @@ def gauss_box(lo, hi, n):
 
 def expected_elements(run):
     """The element boxes (x fastest) and the data points of each, as the README documents."""
-    p = run.group("/params")
+    p = run.values("/params")
     d = run.attrs["dim"]
     lower, upper, cells = p["lower"], p["upper"], int(p["cells"])
     h = (upper - lower) / cells
@@ -1167,7 +1192,7 @@ def test_elements_data_gauss_points_and_norms(run):
     run.require_elements()
     if run.status != "ok":
         pytest.skip("the run did not complete")
-    p, g = run.group("/params"), run.group("/elements")
+    p, g = run.values("/params"), run.group("/elements")
     u = element_function(p["function"])
     boxes, points = expected_elements(run)
     lower, upper = run.ds("/elements/lower"), run.ds("/elements/upper")
@@ -1207,7 +1232,7 @@ def test_element_fits_by_a_second_implementation(run):
     run.require_elements()
     if run.status != "ok":
         pytest.skip("the run did not complete")
-    a, p, g = run.attrs, run.group("/params"), run.group("/elements")
+    a, p, g = run.attrs, run.values("/params"), run.group("/elements")
     d, fixed = a["dim"], g["conservation"] == "fixed"
     u = element_function(p["function"])
     lower, upper = run.ds("/elements/lower"), run.ds("/elements/upper")
@@ -1288,7 +1313,7 @@ LME_RESIDUAL = 1e-12
 
 def shape_lattice(run):
     """The evaluation points: `points` per cell and axis on [0, cells], x fastest."""
-    p = run.group("/params")
+    p = run.values("/params")
     cells, per_cell, d = int(p["cells"]), int(p["points"]), int(p["dim"])
     axis = np.arange(cells * per_cell + 1) / per_cell
     grids = np.meshgrid(*([axis] * d), indexing="ij")
@@ -1385,7 +1410,7 @@ def test_shape_functions_layout(run):
         assert arr.shape == shape, f"/shape_functions/{name} has shape {arr.shape}, not {shape}"
         assert run.units[f"/shape_functions/{name}"] == "1"
     assert np.issubdtype(nodes.dtype, np.integer)
-    assert d == a["dim"] == run.group("/params")["dim"]
+    assert d == a["dim"] == run.values("/params")["dim"]
     if run.status != "ok":
         pytest.skip("the run did not complete")
     expected_x, cells = shape_lattice(run)
