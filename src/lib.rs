@@ -10,6 +10,7 @@ pub mod benchmarks;
 pub mod collect;
 
 pub mod experiment;
+pub mod fallible;
 pub mod integrate;
 pub mod linear_stability;
 pub mod material;

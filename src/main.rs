@@ -7,7 +7,8 @@ use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
 use mpmlab::output::{remove_dead_temps, write_atomically};
 use mpmlab::runner::{
-    check_copy, check_distinct_names, results_dir, run_experiment, RunOptions, EXPERIMENT_COPY,
+    check_copy, check_distinct_names, parse_size, results_dir, run_experiment, RunOptions,
+    EXPERIMENT_COPY,
 };
 use mpmlab::shard::{Plan, Shard};
 use mpmlab::slurm;
@@ -46,6 +47,11 @@ enum Command {
         /// Rerun runs whose file already exists.
         #[arg(long)]
         force: bool,
+        /// Memory the runs in progress may use together, e.g. 48G or 512M (default: the
+        /// memory available when the matrix starts). A run estimated above it is recorded as
+        /// failed; the others wait until it has room for them.
+        #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+        memory: Option<u64>,
         /// Run only shard K of N (1 <= K <= N) of the runs of all the files together. Every
         /// shard computes the same split, so N machines can run one shard each into the same
         /// OUT.
@@ -116,8 +122,18 @@ fn main() -> ExitCode {
             out,
             jobs,
             force,
+            memory,
             shard,
-        } => run(&files, RunOptions { out, jobs, force }, shard),
+        } => run(
+            &files,
+            RunOptions {
+                out,
+                jobs,
+                force,
+                memory,
+            },
+            shard,
+        ),
         Command::Slurm {
             files,
             out,
@@ -245,6 +261,17 @@ fn run(files: &[PathBuf], options: RunOptions, shard: Option<Shard>) -> Result<(
         );
         for line in outcome.diverged.iter().chain(&outcome.failed) {
             eprintln!("  {line}");
+        }
+        if !outcome.unwritten.is_empty() {
+            eprintln!(
+                "{}: {} runs could not be written:",
+                experiment.name,
+                outcome.unwritten.len()
+            );
+            for line in &outcome.unwritten {
+                eprintln!("  {line}");
+            }
+            errors.push(experiment.name.clone());
         }
     }
     match errors.as_slice() {

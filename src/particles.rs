@@ -3,6 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::benchmarks::Problem;
+use crate::fallible::filled;
 use crate::reconstruct::gauss_legendre_rule;
 use crate::shape::{lattice_coords, Grid};
 
@@ -65,6 +66,8 @@ impl<const D: usize> Particles<D> {
         let per_axis: [usize; D] =
             std::array::from_fn(|k| ((hi[k] - lo[k]) / grid.h).round() as usize * ppc);
         let count: usize = per_axis.iter().product();
+        // The largest table first: if the memory is refused, before the others are built.
+        let stress = filled(count, SMatrix::zeros(), "the particles' stresses");
         let lattice = SeedLattice {
             lower: lo,
             spacing,
@@ -102,9 +105,13 @@ impl<const D: usize> Particles<D> {
         Particles {
             x: x0.clone(),
             v,
-            f: vec![SMatrix::identity(); count],
-            j: vec![1.0; count],
-            stress: vec![SMatrix::zeros(); count],
+            f: filled(
+                count,
+                SMatrix::identity(),
+                "the particles' deformation gradients",
+            ),
+            j: filled(count, 1.0, "the particles' Jacobians"),
+            stress,
             mass: volume.iter().map(|v| problem.rho0() * v).collect(),
             volume0: volume.clone(),
             volume,

@@ -4,9 +4,11 @@
 //! (`runner/locks.rs`).
 
 mod locks;
+mod memory;
 
 use std::fs;
 use std::io::{self, IsTerminal};
+use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -15,10 +17,13 @@ use rayon::prelude::*;
 use crate::benchmarks::AnyProblem;
 use crate::experiment::{Experiment, RunSpec};
 use crate::output::{
-    describe_if_missing, remove_dead_temps, run_path, write_atomically, write_run, RunStatus,
+    compute_run, describe_if_missing, read_message, remove_dead_temps, run_path, write_atomically,
+    write_run, RunRecord, RunStatus,
 };
 use crate::params::get_usize;
-use crate::solver::simulate;
+use crate::solver::{estimated_bytes, failed_record, simulate_into};
+
+pub use memory::{parse_size, MemoryBudget, REFUSED};
 
 /// Name of the copy of the experiment file kept beside the runs.
 pub const EXPERIMENT_COPY: &str = "experiment.yaml";
@@ -30,6 +35,8 @@ pub struct RunOptions {
     pub jobs: usize,
     /// Rerun runs whose file already exists.
     pub force: bool,
+    /// Bytes the runs in progress may use together (default: the memory available).
+    pub memory: Option<u64>,
 }
 
 #[derive(Debug, Default)]
@@ -41,6 +48,8 @@ pub struct MatrixOutcome {
     /// `run_id: message` of each run that did not finish normally.
     pub diverged: Vec<String>,
     pub failed: Vec<String>,
+    /// `run_id: error` of each run of which no file could be written, not even of its failure.
+    pub unwritten: Vec<String>,
 }
 
 /// The directory an experiment's results go to.
@@ -56,28 +65,39 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
     locks::remove_leftovers(&dir)?;
     let mut outcome = MatrixOutcome::default();
     let mut runs: Vec<&RunSpec> = experiment.runs.iter().collect();
+    let budget = MemoryBudget::new(options.memory);
     // Runs another process held but ended without writing come back for another pass.
     while !runs.is_empty() {
-        runs = run_pass(&dir, &experiment.name, &runs, options, &mut outcome)?;
+        runs = run_pass(
+            &dir,
+            &experiment.name,
+            &runs,
+            options,
+            &budget,
+            &mut outcome,
+        )?;
     }
     outcome.diverged.sort();
     outcome.failed.sort();
+    outcome.unwritten.sort();
     Ok(outcome)
 }
 
-/// Computes the runs of `runs` that have no file (every one with `force`) and whose lock this
-/// process takes, then waits for those another process holds; returns the runs of these that
+/// Computes the runs of `runs` that have no file (every one with `force`), or whose file says
+/// they were refused for memory, and whose lock this process takes, each once `budget` has
+/// room for it, then waits for those another process holds; returns the runs of these that
 /// their holder did not write.
 fn run_pass<'a>(
     dir: &Path,
     name: &str,
     runs: &[&'a RunSpec],
     options: &RunOptions,
+    budget: &MemoryBudget,
     outcome: &mut MatrixOutcome,
 ) -> io::Result<Vec<&'a RunSpec>> {
     let (todo, done): (Vec<&RunSpec>, Vec<&RunSpec>) = runs
         .iter()
-        .partition(|run| options.force || !run_path(dir, &run.run_id).exists());
+        .partition(|run| needs_run(dir, &run.run_id, options.force));
     // A skipped run still gets the XDMF description it lacks.
     for run in &done {
         describe_if_missing(&run_path(dir, &run.run_id))?;
@@ -92,37 +112,92 @@ fn run_pass<'a>(
         .build()
         .map_err(io::Error::other)?;
     let claims = locks::Claims::new(dir, options.force);
-    let results: Vec<io::Result<(String, RunStatus, String)>> = pool.install(|| {
+    let results: Vec<(&RunSpec, io::Result<(RunStatus, String)>)> = pool.install(|| {
         todo.par_iter()
             .filter(|run| claims.take(run))
-            .map(|run| {
-                let record = simulate(run);
-                write_run(dir, &record)?;
-                progress.inc(1);
-                Ok((run.run_id.clone(), record.status, record.message))
-            })
-            .inspect(|result| {
-                if let Ok((run_id, _, _)) = result {
-                    claims.release(run_id);
+            .map(|&run| {
+                let bytes = estimated_bytes(run);
+                let result = match budget.refusal(bytes) {
+                    Some(message) => record_failure(dir, run, message),
+                    None => {
+                        let _hold = budget.hold(bytes);
+                        execute(dir, run, simulate_into)
+                    }
+                };
+                if result.is_ok() {
+                    claims.release(&run.run_id);
                 }
+                progress.inc(1);
+                (run, result)
             })
             .collect()
     });
     progress.finish_and_clear();
 
     outcome.skipped += done.len();
-    for result in results {
-        let (run_id, status, message) = result?;
-        outcome.written += 1;
-        match status {
-            RunStatus::Ok => {}
-            RunStatus::Diverged => outcome.diverged.push(format!("{run_id}: {message}")),
-            RunStatus::Failed => outcome.failed.push(format!("{run_id}: {message}")),
+    for (run, result) in results {
+        let run_id = &run.run_id;
+        match result {
+            Ok((status, message)) => {
+                outcome.written += 1;
+                match status {
+                    RunStatus::Ok => {}
+                    RunStatus::Diverged => outcome.diverged.push(format!("{run_id}: {message}")),
+                    RunStatus::Failed => outcome.failed.push(format!("{run_id}: {message}")),
+                }
+            }
+            Err(e) => outcome.unwritten.push(format!("{run_id}: {e}")),
         }
     }
     let waited = claims.wait_for_others(name)?;
     outcome.elsewhere += waited.elsewhere;
     Ok(waited.orphans)
+}
+
+/// Whether the run is to be computed: it has no file, or its file records that it was refused
+/// for memory (`REFUSED`), or `force` says to compute it again.
+fn needs_run(dir: &Path, run_id: &str, force: bool) -> bool {
+    let path = run_path(dir, run_id);
+    force || !path.exists() || read_message(&path).is_some_and(|m| m.starts_with(REFUSED))
+}
+
+/// Computes one run into its file and returns its status and message. A panic is caught and
+/// recorded as the run's failure, as is an error writing its file (in a file of the failed
+/// run, if that can be written), so neither stops the other runs; the error is returned when
+/// not even that file could be written.
+fn execute(
+    dir: &Path,
+    run: &RunSpec,
+    simulate: impl FnOnce(&RunSpec, &hdf5::File) -> RunRecord,
+) -> io::Result<(RunStatus, String)> {
+    let computed = panic::catch_unwind(AssertUnwindSafe(|| {
+        compute_run(dir, &run.run_id, |file| simulate(run, file))
+    }));
+    let message = match computed {
+        Ok(Ok(record)) => return Ok((record.status, record.message)),
+        Ok(Err(e)) => format!("its file could not be written: {e}"),
+        Err(payload) => format!("stopped by an internal error: {}", panic_text(&*payload)),
+    };
+    record_failure(dir, run, message)
+}
+
+/// Writes the file of a run that failed with `message` before or while it ran.
+fn record_failure(dir: &Path, run: &RunSpec, message: String) -> io::Result<(RunStatus, String)> {
+    match write_run(dir, &failed_record(run, message.clone())) {
+        Ok(_) => Ok((RunStatus::Failed, message)),
+        Err(e) => Err(io::Error::other(format!(
+            "{message}; nor could the failure be recorded: {e}"
+        ))),
+    }
+}
+
+/// What a panic said.
+fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
+    payload
+        .downcast_ref::<&str>()
+        .copied()
+        .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+        .unwrap_or("a panic without a message")
 }
 
 /// A run's cost in particle-steps: its particles (`cells * ppc` per axis) times the time
@@ -242,4 +317,50 @@ fn progress_bar(name: &str, len: usize) -> ProgressBar {
     bar.set_style(style);
     bar.set_prefix(name.to_string());
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::{open_run_file, read_summary};
+
+    /// Two runs of a small bar.
+    fn runs() -> Vec<RunSpec> {
+        let yaml = "name: t\nbenchmark: vibrating_bar\nparams: {method: mpm}\n\
+                    matrix:\n  cells: [4, 5]\n";
+        crate::experiment::parse(yaml, Path::new("t.yaml"))
+            .unwrap()
+            .runs
+    }
+
+    fn status(dir: &Path, run: &RunSpec) -> (RunStatus, String) {
+        let file = open_run_file(&run_path(dir, &run.run_id)).unwrap();
+        let summary = read_summary(&file).unwrap();
+        (summary.status, summary.message)
+    }
+
+    /// A run that panics half way through its file is recorded as failed, with the panic's
+    /// words, in a whole file of its own; the next run is computed as usual.
+    #[test]
+    fn a_panicking_run_is_recorded_as_failed_and_the_next_goes_on() {
+        let dir = tempfile::tempdir().unwrap();
+        let runs = runs();
+        let panicking = |_: &RunSpec, file: &hdf5::File| -> RunRecord {
+            file.create_group("history").unwrap();
+            panic!("boom")
+        };
+        let (status_of_first, message) = execute(dir.path(), &runs[0], panicking).unwrap();
+        assert_eq!(status_of_first, RunStatus::Failed);
+        assert_eq!(message, "stopped by an internal error: boom");
+        assert_eq!(status(dir.path(), &runs[0]), (RunStatus::Failed, message));
+        let (second, _) = execute(dir.path(), &runs[1], simulate_into).unwrap();
+        assert_eq!(second, RunStatus::Ok);
+        assert_eq!(status(dir.path(), &runs[1]).0, RunStatus::Ok);
+        let leftovers: Vec<_> = fs::read_dir(dir.path().join("runs"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|name| name.to_string_lossy().contains(".tmp-"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+    }
 }

@@ -33,6 +33,7 @@ fn a_figure_of_two_listed_methods_draws_those_two() {
         out: out.path().to_path_buf(),
         jobs: 2,
         force: false,
+        memory: None,
     };
     let outcome = run_experiment(&exp, &options).unwrap();
     assert!(outcome.failed.is_empty() && outcome.diverged.is_empty());

@@ -25,6 +25,7 @@ fn options(out: &Path, jobs: usize, force: bool) -> RunOptions {
         out: out.to_path_buf(),
         jobs,
         force,
+        memory: None,
     }
 }
 

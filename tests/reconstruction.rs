@@ -36,6 +36,7 @@ fn run(name: &str, out: &Path) -> mpmlab::collect::Collected {
         out: out.to_path_buf(),
         jobs: 2,
         force: false,
+        memory: None,
     };
     let outcome = run_experiment(&exp, &options).unwrap();
     assert!(outcome.failed.is_empty() && outcome.diverged.is_empty());

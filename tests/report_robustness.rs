@@ -10,7 +10,7 @@ use std::process::{Command, Output};
 
 use mpmlab::collect::collect;
 use mpmlab::experiment::{self, Experiment};
-use mpmlab::output::{run_path, temp_path};
+use mpmlab::output::{run_path, temp_path, SCHEMA_VERSION};
 use mpmlab::report;
 use mpmlab::runner::results_dir;
 
@@ -213,8 +213,10 @@ fn unreadable_run_files_are_listed_with_the_reason_and_the_others_reported() {
         ),
         (
             name(12),
-            "written with layout version 1, this mpmlab reads version 2 (rerun it with --force)"
-                .to_string(),
+            format!(
+                "written with layout version 1, this mpmlab reads version {SCHEMA_VERSION} \
+                 (rerun it with --force)"
+            ),
         ),
         (
             name(14),

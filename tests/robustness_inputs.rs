@@ -11,10 +11,11 @@ use mpmlab::benchmarks::{self, AnyProblem, MAX_POINTS, MAX_STEPS};
 use mpmlab::experiment::{
     self, ConfigError, Experiment, MAX_LIST_VALUES, MAX_NAME_LEN, MAX_RUN_ID_LEN, MAX_SAMPLES,
 };
-use mpmlab::output::{open_run_file, read_summary, run_path};
+use mpmlab::output::{open_run_file, read_summary, run_path, RunStatus};
 use mpmlab::params::ParamValue;
-use mpmlab::runner::{results_dir, run_experiment, RunOptions};
+use mpmlab::runner::{results_dir, run_experiment, RunOptions, REFUSED};
 use mpmlab::shape::MAX_STENCIL_NODES;
+use mpmlab::solver::estimated_bytes;
 
 const DIR: &str = "tests/inputs/robustness";
 
@@ -260,6 +261,7 @@ fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {
         out: out.path().to_path_buf(),
         jobs: 1,
         force: false,
+        memory: None,
     };
     let outcome = run_experiment(&experiment, &options).unwrap();
     assert_eq!(
@@ -370,4 +372,54 @@ fn a_closed_standard_output_ends_the_program_quietly() {
             String::from_utf8_lossy(&output.stderr)
         );
     }
+}
+
+/// A run estimated above the memory the runs may use is recorded as failed, with its estimate
+/// and the limit, and the rest of the matrix completes; a rerun under a larger limit computes
+/// it.
+#[test]
+fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
+    let yaml = "name: memory\nbenchmark: vibrating_bar\nparams: {method: mpm, ppc: 4}\n\
+                matrix:\n  cells: [4, 400]\n";
+    let experiment = experiment::parse(yaml, Path::new("memory.yaml")).unwrap();
+    let [small, large] = [&experiment.runs[0], &experiment.runs[1]];
+    let (need_small, need_large) = (estimated_bytes(small), estimated_bytes(large));
+    assert!(need_small < need_large, "{need_small} {need_large}");
+    let out = tempfile::tempdir().unwrap();
+    let mut options = RunOptions {
+        out: out.path().to_path_buf(),
+        jobs: 2,
+        force: false,
+        memory: Some(((need_small + need_large) / 2.0) as u64),
+    };
+    let outcome = run_experiment(&experiment, &options).unwrap();
+    assert_eq!(
+        (outcome.written, outcome.failed.len()),
+        (2, 1),
+        "{outcome:?}"
+    );
+    let failure = &outcome.failed[0];
+    assert!(
+        failure.starts_with(&format!("{}: {REFUSED}", large.run_id)),
+        "{failure}"
+    );
+    assert!(
+        failure.contains("it needs an estimated") && failure.contains("of --memory"),
+        "{failure}"
+    );
+    let dir = results_dir(out.path(), &experiment);
+    let summary = |run: &experiment::RunSpec| {
+        read_summary(&open_run_file(&run_path(&dir, &run.run_id)).unwrap()).unwrap()
+    };
+    assert_eq!(summary(large).status, RunStatus::Failed);
+    assert_eq!(summary(small).status, RunStatus::Ok);
+
+    options.memory = Some((2.0 * need_large) as u64);
+    let rerun = run_experiment(&experiment, &options).unwrap();
+    assert_eq!(
+        (rerun.written, rerun.skipped, rerun.failed.len()),
+        (1, 1, 0),
+        "{rerun:?}"
+    );
+    assert_eq!(summary(large).status, RunStatus::Ok);
 }

@@ -40,6 +40,7 @@ fn runs_either_side_of_the_limit_are_told_apart() {
         out: tmp.path().to_path_buf(),
         jobs: 2,
         force: false,
+        memory: None,
     };
     run_experiment(&exp, &options).unwrap();
     let collected = collect(&results_dir(tmp.path(), &exp)).unwrap();

@@ -2,24 +2,57 @@ use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use super::{write_hdf5, write_xdmf, xdmf_path, HistoryLayout, RunRecord};
+use super::{write_hdf5, write_record, write_xdmf, xdmf_path, HistoryLayout, RunRecord};
 
 /// Where the run with this id lives inside an experiment's results directory.
 pub fn run_path(results: &Path, run_id: &str) -> PathBuf {
     results.join("runs").join(format!("{run_id}.h5"))
 }
 
-/// Writes the record under a temporary name and renames it into place, then likewise the
-/// XDMF description of its particle history, if it has one.
+/// Writes a record kept in memory under a temporary name and renames it into place, then
+/// likewise the XDMF description of its particle history, if it has one.
 pub fn write_run(results: &Path, record: &RunRecord) -> io::Result<PathBuf> {
     let path = run_path(results, &record.spec.run_id);
-    write_atomically(&path, |tmp| {
-        write_hdf5(tmp, record).map_err(|e| io::Error::other(format!("{}: {e}", path.display())))
-    })?;
-    if let Some(layout) = HistoryLayout::of(record) {
-        write_xdmf(&path, &layout)?;
-    }
+    write_atomically(&path, |tmp| write_hdf5(tmp, record).map_err(naming(&path)))?;
+    describe(&path, record)?;
     Ok(path)
+}
+
+/// Computes the run `run_id` into its file: `compute` is given the new file, under its
+/// temporary name, to stream the history into, and returns the record, whose rest is written
+/// before the file is renamed into place (and its XDMF description written). An error leaves
+/// no file of the run.
+pub fn compute_run(
+    results: &Path,
+    run_id: &str,
+    compute: impl FnOnce(&hdf5::File) -> RunRecord,
+) -> io::Result<RunRecord> {
+    let path = run_path(results, run_id);
+    let mut computed = None;
+    write_atomically(&path, |tmp| {
+        let file = hdf5::File::create_excl(tmp).map_err(naming(&path))?;
+        let record = computed.insert(compute(&file));
+        let written = match record.stream.take() {
+            Some(Err(e)) => Err(hdf5::Error::from(e)),
+            stream => write_record(&file, record, stream.and_then(Result::ok)),
+        };
+        written.and_then(|()| file.close()).map_err(naming(&path))
+    })?;
+    let record = computed.ok_or_else(|| io::Error::other("the run was not computed"))?;
+    describe(&path, &record)?;
+    Ok(record)
+}
+
+/// Writes the XDMF description of a run's particle history, if it has one.
+fn describe(path: &Path, record: &RunRecord) -> io::Result<()> {
+    match HistoryLayout::of(record) {
+        Some(layout) => write_xdmf(path, &layout),
+        None => Ok(()),
+    }
+}
+
+fn naming(path: &Path) -> impl Fn(hdf5::Error) -> io::Error + '_ {
+    move |e| io::Error::other(format!("{}: {e}", path.display()))
 }
 
 /// Writes the XDMF description of a complete run file that has a particle history but no

@@ -289,17 +289,19 @@ mod reader;
 mod reconstruction;
 mod record;
 mod shape_functions;
+mod stream;
 mod writer;
 mod xdmf;
 
 pub use atomic::{
-    describe_if_missing, host_tag, remove_dead_temps, run_path, temp_path, this_host,
+    compute_run, describe_if_missing, host_tag, remove_dead_temps, run_path, temp_path, this_host,
     write_all_atomically, write_atomically, write_run, TempHost, TempWriter,
 };
 pub use elements::ElementRecord;
 pub use probes::{ProbeRecord, Wiggles, REFERENCE_KINDS};
 pub use reader::{
-    open_hdf5, open_run_file, read_final_state, read_probes, read_summary, UnreadableRun,
+    open_hdf5, open_run_file, read_final_state, read_message, read_probes, read_summary,
+    UnreadableRun,
 };
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
@@ -307,6 +309,7 @@ pub use record::{
     ParticleTable, RunRecord,
 };
 pub use shape_functions::ShapeFunctionRecord;
-pub use writer::write_hdf5;
+pub use stream::{HistoryStream, StreamShape};
+pub use writer::{write_hdf5, write_record};
 pub use xdmf::xdmf_path;
 use xdmf::{write_xdmf, HistoryLayout};

@@ -5,13 +5,13 @@
 use hdf5::{File, Group};
 
 use super::reader::{open_attr, open_dataset, read_i64, read_str};
-use super::writer::{attr_f64, attr_i64, attr_str, dataset};
+use super::writer::{attr_f64, attr_i64, attr_str};
 
-const GROUP: &str = "probes";
-const TIME: &str = "time";
-const STEP: &str = "step";
-const VALUE: &str = "value";
-const REFERENCE: &str = "reference";
+pub(super) const GROUP: &str = "probes";
+pub(super) const TIME: &str = "time";
+pub(super) const STEP: &str = "step";
+pub(super) const VALUE: &str = "value";
+pub(super) const REFERENCE: &str = "reference";
 const PARTICLE: &str = "particle";
 const X0: &str = "x0";
 const QUANTITY: &str = "quantity";
@@ -60,23 +60,11 @@ pub struct Wiggles {
 impl ProbeRecord {
     /// The wiggle measures of the recorded history.
     pub fn wiggles(&self) -> Wiggles {
-        let has_reference =
-            !self.reference.is_empty() && self.reference.iter().all(|r| r.is_finite());
-        let (low, high) = range(&self.value);
-        let (ref_low, ref_high) = range(&self.reference);
-        Wiggles {
-            total_variation: total_variation(&self.value),
-            reference_total_variation: if has_reference {
-                total_variation(&self.reference)
-            } else {
-                f64::NAN
-            },
-            overshoot: if has_reference {
-                (high - ref_high).max(ref_low - low).max(0.0)
-            } else {
-                f64::NAN
-            },
+        let mut tally = WiggleTally::default();
+        for (&value, &reference) in self.value.iter().zip(&self.reference) {
+            tally.push(value, reference);
         }
+        tally.wiggles()
     }
 
     /// The unit of the quantity.
@@ -89,25 +77,74 @@ impl ProbeRecord {
     }
 }
 
-/// Writes `/probes` when there are any.
-pub(super) fn write(file: &File, probes: &[ProbeRecord]) -> hdf5::Result<()> {
-    if probes.is_empty() {
-        return Ok(());
+/// The wiggle measures of a history taken one step at a time, as it is recorded.
+#[derive(Clone, Copy, Debug)]
+pub struct WiggleTally {
+    steps: usize,
+    last: (f64, f64),
+    total_variation: f64,
+    reference_total_variation: f64,
+    /// The least and the largest value, and of the reference.
+    range: (f64, f64),
+    reference_range: (f64, f64),
+    reference_known: bool,
+}
+
+impl Default for WiggleTally {
+    fn default() -> Self {
+        WiggleTally {
+            steps: 0,
+            last: (f64::NAN, f64::NAN),
+            total_variation: 0.0,
+            reference_total_variation: 0.0,
+            range: (f64::INFINITY, f64::NEG_INFINITY),
+            reference_range: (f64::INFINITY, f64::NEG_INFINITY),
+            reference_known: true,
+        }
     }
-    let group = file.create_group(GROUP)?;
-    for probe in probes {
-        let g = group.create_group(&probe.name)?;
-        let nt = probe.time.len();
-        dataset(&g, TIME, &probe.time, &[nt], "s")?;
-        dataset(&g, STEP, &probe.step, &[nt], "1")?;
-        dataset(&g, VALUE, &probe.value, &[nt], probe.unit())?;
-        dataset(&g, REFERENCE, &probe.reference, &[nt], probe.unit())?;
+}
+
+impl WiggleTally {
+    /// The next step's value and reference (NaN when there is none).
+    pub fn push(&mut self, value: f64, reference: f64) {
+        if self.steps > 0 {
+            self.total_variation += (value - self.last.0).abs();
+            self.reference_total_variation += (reference - self.last.1).abs();
+        }
+        let widen = |(low, high): (f64, f64), v: f64| (low.min(v), high.max(v));
+        self.range = widen(self.range, value);
+        self.reference_range = widen(self.reference_range, reference);
+        self.reference_known &= reference.is_finite();
+        self.last = (value, reference);
+        self.steps += 1;
+    }
+
+    pub fn wiggles(&self) -> Wiggles {
+        let has_reference = self.steps > 0 && self.reference_known;
+        let ((low, high), (ref_low, ref_high)) = (self.range, self.reference_range);
+        let if_reference = |x: f64| if has_reference { x } else { f64::NAN };
+        Wiggles {
+            total_variation: self.total_variation,
+            reference_total_variation: if_reference(self.reference_total_variation),
+            overshoot: if_reference((high - ref_high).max(ref_low - low).max(0.0)),
+        }
+    }
+}
+
+/// Writes the attributes of the probes whose groups and datasets `HistoryStream` wrote, in
+/// its order, with each one's wiggle measures.
+pub(super) fn write_attributes(
+    file: &File,
+    probes: &[ProbeRecord],
+    wiggles: &[Wiggles],
+) -> hdf5::Result<()> {
+    for (probe, wiggles) in probes.iter().zip(wiggles) {
+        let g = file.group(GROUP)?.group(&probe.name)?;
         attr_i64(&g, PARTICLE, probe.particle)?;
         attr_list(&g, X0, &probe.x0)?;
         attr_str(&g, QUANTITY, &probe.quantity)?;
         attr_list(&g, COMPONENT, &probe.component)?;
         attr_str(&g, REFERENCE, &probe.reference_kind)?;
-        let wiggles = probe.wiggles();
         attr_f64(&g, TOTAL_VARIATION, wiggles.total_variation)?;
         attr_f64(
             &g,
@@ -117,19 +154,6 @@ pub(super) fn write(file: &File, probes: &[ProbeRecord]) -> hdf5::Result<()> {
         attr_f64(&g, OVERSHOOT, wiggles.overshoot)?;
     }
     Ok(())
-}
-
-fn total_variation(values: &[f64]) -> f64 {
-    values.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
-}
-
-/// The least and the largest value; (inf, -inf) when there is none.
-fn range(values: &[f64]) -> (f64, f64) {
-    values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        })
 }
 
 /// Every probe of the file, by name; none when it has no `/probes`.

@@ -48,6 +48,12 @@ pub fn open_run_file(path: &Path) -> Result<hdf5::File, String> {
     Ok(file)
 }
 
+/// The `message` a run file records, if it can be read.
+pub fn read_message(path: &Path) -> Option<String> {
+    let file = hdf5::File::open(path).ok()?;
+    read_str(&file, "message").ok()
+}
+
 /// The HDF5 signature, which the format allows at offset 0, 512, 1024, 2048, ...
 const SIGNATURE: &[u8; 8] = b"\x89HDF\r\n\x1a\n";
 

@@ -1,10 +1,12 @@
-use super::{ElementRecord, ProbeRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord};
+use super::{
+    ElementRecord, HistoryStream, ProbeRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord,
+};
 use crate::experiment::RunSpec;
 use crate::methods::Method;
 
 /// Everything written to one run file, as flat row-major arrays so that the layout does
 /// not depend on the dimension at compile time.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct RunRecord {
     pub spec: RunSpec,
     pub parts: MethodParts,
@@ -33,6 +35,10 @@ pub struct RunRecord {
     pub elements: Option<ElementRecord>,
     /// Set instead for the runs of the shape-function benchmark.
     pub shape_functions: Option<ShapeFunctionRecord>,
+    /// The arrays of `history`, `grid`, `errors` and `probes` that grow with the samples and
+    /// steps, when the run wrote them to its file as it went (those vectors then hold none),
+    /// or why writing them failed.
+    pub stream: Option<Result<HistoryStream, String>>,
 }
 
 /// The root attributes `shape`, `transfer` and `integrator`: what the run's method is made of.

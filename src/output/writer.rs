@@ -4,42 +4,70 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
 use ndarray::{ArrayView, IxDyn};
 
+use super::stream::{HistoryStream, StreamShape};
 use super::{
     elements, probes, reconstruction, shape_functions, RunRecord, CONFIG_YAML, ERROR_FIELDS,
     GRID_VELOCITY, SCHEMA_VERSION,
 };
 use crate::params::ParamValue;
 
-/// Writes the whole record into a new HDF5 file at `path` (which must not exist).
+/// Writes the whole record, kept in memory, into a new HDF5 file at `path` (which must not
+/// exist).
 pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     let file = hdf5::File::create_excl(path)?;
-    write_identity(&file, r)?;
+    write_record(&file, r, None)
+}
+
+/// Writes the record into `file`. A run that streamed its growing arrays into `file` passes
+/// its `stream`, which the record's arrays continue; without one they are all in `r`.
+pub fn write_record(
+    file: &hdf5::File,
+    r: &RunRecord,
+    stream: Option<HistoryStream>,
+) -> hdf5::Result<()> {
+    write_identity(file, r)?;
     if let Some(record) = &r.reconstruction {
-        reconstruction::write(&file, record)?;
+        reconstruction::write(file, record)?;
         return file.flush();
     }
     if let Some(record) = &r.elements {
-        elements::write(&file, record)?;
+        elements::write(file, record)?;
         return file.flush();
     }
     if let Some(record) = &r.shape_functions {
-        shape_functions::write(&file, record)?;
+        shape_functions::write(file, record)?;
         return file.flush();
     }
     let d = r.dim;
     let np = r.particles.len();
     let nt = r.history.time.len();
+    let nn = r.grid.weight.len();
+    let stream = match stream {
+        Some(stream) => stream,
+        None => {
+            let shape = StreamShape {
+                dim: d,
+                particles: np,
+                dofs: nn,
+            };
+            let mut stream = HistoryStream::create(file, shape, &r.probes)?;
+            stream.append_samples(nt, &r.history, &r.grid, &r.errors)?;
+            stream.append_probes(&r.probes)?;
+            stream
+        }
+    };
+    let wiggles = stream.finish()?;
 
     for (name, value) in [
         ("shape", &r.parts.shape),
         ("transfer", &r.parts.transfer),
         ("integrator", &r.parts.integrator),
     ] {
-        attr_str(&file, name, value)?;
+        attr_str(file, name, value)?;
     }
-    attr_i64(&file, "steps", r.steps as i64)?;
+    attr_i64(file, "steps", r.steps as i64)?;
     for (name, value) in [("dt", r.dt), ("t_end", r.t_end)] {
-        attr_f64(&file, name, value)?;
+        attr_f64(file, name, value)?;
     }
 
     let particles = file.create_group("particles")?;
@@ -47,47 +75,33 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     dataset(&particles, "mass", &r.particles.mass, &[np], "kg")?;
     dataset(&particles, "volume0", &r.particles.volume0, &[np], "m^D")?;
 
-    let history = file.create_group("history")?;
+    let history = file.group("history")?;
     dataset(&history, "time", &r.history.time, &[nt], "s")?;
     dataset(&history, "step", &r.history.step, &[nt], "1")?;
-    dataset(&history, "x", &r.history.x, &[nt, np, d], "m")?;
-    dataset(&history, "v", &r.history.v, &[nt, np, d], "m/s")?;
-    dataset(&history, "stress", &r.history.stress, &[nt, np, d, d], "Pa")?;
-    dataset(&history, "density", &r.history.density, &[nt, np], "kg/m^D")?;
 
-    let nn = r.grid.weight.len();
-    let grid = file.create_group("grid")?;
+    let grid = file.group("grid")?;
     dataset(&grid, "x", &r.grid.x, &[nn, d], "m")?;
     dataset(&grid, "weight", &r.grid.weight, &[nn], "m^D")?;
     dataset(&grid, "time", &r.grid.time, &[nt], "s")?;
-    dataset(&grid, "v", &r.grid.v, &[nt, nn, d], "m/s")?;
 
-    let errors = file.create_group("errors")?;
+    let errors = file.group("errors")?;
     dataset(&errors, "time", &r.history.time, &[nt], "s")?;
-    dataset(&errors, "volume", &r.errors.volume, &[nt, np], "m^D")?;
     let norms = errors.create_group("norms")?;
     let e = &r.errors;
     let grid_velocity = &e.grid_velocity;
     let fields = ERROR_FIELDS
         .iter()
         .enumerate()
-        .map(|(f, &field)| (field, np, &e.pointwise[f], [&e.l2[f], &e.rms[f]]))
-        .chain([(
-            GRID_VELOCITY,
-            nn,
-            &grid_velocity.pointwise,
-            [&grid_velocity.l2, &grid_velocity.rms],
-        )]);
-    for (field, points, pointwise, [l2, rms]) in fields {
+        .map(|(f, &field)| (field, [&e.l2[f], &e.rms[f]]))
+        .chain([(GRID_VELOCITY, [&grid_velocity.l2, &grid_velocity.rms])]);
+    for (field, [l2, rms]) in fields {
         let unit = field_unit(field);
-        dataset(&errors, field, pointwise, &[nt, points], unit)?;
         for (norm, values) in [("l2", l2), ("rms", rms)] {
             let name = format!("{norm}_{field}");
             dataset(&norms, &name, values, &[nt], unit)?;
             attr_f64(&norms, &name, values.last().copied().unwrap_or(f64::NAN))?;
         }
     }
-
     let conservation = file.create_group("conservation")?;
     dataset(&conservation, "time", &r.history.time, &[nt], "s")?;
     for (name, values) in [
@@ -111,9 +125,8 @@ pub fn write_hdf5(path: &Path, r: &RunRecord) -> hdf5::Result<()> {
     ] {
         attr_i64(&diagnostics, name, value as i64)?;
     }
-    probes::write(&file, &r.probes)?;
-    file.flush()?;
-    Ok(())
+    probes::write_attributes(file, &r.probes, &wiggles)?;
+    file.flush()
 }
 
 /// What every run file has: the root attributes that identify the run and its outcome, and
@@ -149,7 +162,7 @@ fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
     Ok(())
 }
 
-fn field_unit(field: &str) -> &'static str {
+pub(super) fn field_unit(field: &str) -> &'static str {
     match field {
         "displacement" => "m",
         "velocity" | GRID_VELOCITY => "m/s",

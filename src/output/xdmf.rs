@@ -72,8 +72,13 @@ pub fn write_xdmf(run_file: &Path, layout: &HistoryLayout) -> io::Result<()> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let text = describe(&name, layout);
-    write_atomically(&xdmf_path(run_file), |tmp| std::fs::write(tmp, &text))
+    write_atomically(&xdmf_path(run_file), |tmp| {
+        let mut out = io::BufWriter::new(std::fs::File::create(tmp)?);
+        write_description(&mut out, &name, layout)?;
+        out.into_inner()
+            .map_err(io::IntoInnerError::into_error)?
+            .sync_all()
+    })
 }
 
 /// How one particle's value of a dataset is shaped.
@@ -103,69 +108,89 @@ fn attributes() -> Vec<(String, String, Rank)> {
     fields
 }
 
-/// The XDMF text for the run file named `run_file` (relative to the description).
-pub fn describe(run_file: &str, layout: &HistoryLayout) -> String {
-    let (np, d) = (layout.particles, layout.dim);
-    let mut collection = Element::new("Grid")
+/// Writes the XDMF text for the run file named `run_file` (relative to the description) one
+/// sample's grid at a time, so that its memory does not grow with
+/// the samples.
+fn write_description(
+    out: &mut impl io::Write,
+    run_file: &str,
+    layout: &HistoryLayout,
+) -> io::Result<()> {
+    let collection = Element::new("Grid")
         .attr("Name", run_file.strip_suffix(".h5").unwrap_or(run_file))
         .attr("GridType", "Collection")
         .attr("CollectionType", "Temporal");
-    for (sample, time) in layout.time.iter().enumerate() {
-        let slab = Slab {
-            file: run_file,
-            samples: layout.time.len(),
-            sample,
-            particles: np,
-            dim: d,
-        };
-        let position = slab.item("/history/x", Rank::Vector);
-        let geometry = match d {
-            // A bar lies on the x axis: y = z = 0 times its x.
-            1 => {
-                let zero = Element::new("DataItem")
-                    .attr("ItemType", "Function")
-                    .attr("Function", "0 * $0")
-                    .attr("Dimensions", np)
-                    .child(position.clone());
-                Element::new("Geometry")
-                    .attr("GeometryType", "X_Y_Z")
-                    .child(position)
-                    .child(zero.clone())
-                    .child(zero)
-            }
-            _ => Element::new("Geometry")
-                .attr("GeometryType", if d == 2 { "XY" } else { "XYZ" })
-                .child(position),
-        };
-        let mut grid = Element::new("Grid")
-            .attr("Name", format!("sample {sample}"))
-            .attr("GridType", "Uniform")
-            // Debug formatting is the shortest text that reads back as the same f64.
-            .child(Element::new("Time").attr("Value", format!("{time:?}")))
-            .child(
-                Element::new("Topology")
-                    .attr("TopologyType", "Polyvertex")
-                    .attr("NumberOfElements", np)
-                    .attr("NodesPerElement", 1),
-            )
-            .child(geometry);
-        for (name, path, rank) in attributes() {
-            grid = grid.child(
-                Element::new("Attribute")
-                    .attr("Name", name)
-                    .attr("AttributeType", attribute_type(rank, d))
-                    .attr("Center", "Node")
-                    .child(slab.item(&path, rank)),
-            );
-        }
-        collection = collection.child(grid);
+    let outer = [
+        Element::new("Xdmf").attr("Version", "2.0"),
+        Element::new("Domain"),
+        collection,
+    ];
+    let mut text = String::from("<?xml version=\"1.0\" ?>\n");
+    for (depth, element) in outer.iter().enumerate() {
+        element.open(&mut text, depth);
     }
-    let xdmf = Element::new("Xdmf")
-        .attr("Version", "2.0")
-        .child(Element::new("Domain").child(collection));
-    let mut out = String::from("<?xml version=\"1.0\" ?>\n");
-    xdmf.write(&mut out, 0);
-    out
+    for (sample, &time) in layout.time.iter().enumerate() {
+        sample_grid(run_file, layout, sample, time).write(&mut text, outer.len());
+        out.write_all(text.as_bytes())?;
+        text.clear();
+    }
+    for (depth, element) in outer.iter().enumerate().rev() {
+        element.close(&mut text, depth);
+    }
+    out.write_all(text.as_bytes())
+}
+
+/// The grid of one sample: the particles at `time` as a Polyvertex with every attribute.
+fn sample_grid(run_file: &str, layout: &HistoryLayout, sample: usize, time: f64) -> Element {
+    let (np, d) = (layout.particles, layout.dim);
+    let slab = Slab {
+        file: run_file,
+        samples: layout.time.len(),
+        sample,
+        particles: np,
+        dim: d,
+    };
+    let position = slab.item("/history/x", Rank::Vector);
+    let geometry = match d {
+        // A bar lies on the x axis: y = z = 0 times its x.
+        1 => {
+            let zero = Element::new("DataItem")
+                .attr("ItemType", "Function")
+                .attr("Function", "0 * $0")
+                .attr("Dimensions", np)
+                .child(position.clone());
+            Element::new("Geometry")
+                .attr("GeometryType", "X_Y_Z")
+                .child(position)
+                .child(zero.clone())
+                .child(zero)
+        }
+        _ => Element::new("Geometry")
+            .attr("GeometryType", if d == 2 { "XY" } else { "XYZ" })
+            .child(position),
+    };
+    let mut grid = Element::new("Grid")
+        .attr("Name", format!("sample {sample}"))
+        .attr("GridType", "Uniform")
+        // Debug formatting is the shortest text that reads back as the same f64.
+        .child(Element::new("Time").attr("Value", format!("{time:?}")))
+        .child(
+            Element::new("Topology")
+                .attr("TopologyType", "Polyvertex")
+                .attr("NumberOfElements", np)
+                .attr("NodesPerElement", 1),
+        )
+        .child(geometry);
+    for (name, path, rank) in attributes() {
+        grid = grid.child(
+            Element::new("Attribute")
+                .attr("Name", name)
+                .attr("AttributeType", attribute_type(rank, d))
+                .attr("Center", "Node")
+                .child(slab.item(&path, rank)),
+        );
+    }
+    grid
 }
 
 /// One sample of a (samples x particles x components) dataset.
@@ -275,24 +300,39 @@ impl Element {
     }
 
     fn write(&self, out: &mut String, depth: usize) {
-        let indent = "  ".repeat(depth);
-        out.push_str(&indent);
+        if !self.text.is_empty() {
+            self.start(out, depth);
+            out.push_str(&format!(">{}</{}>\n", escape(&self.text), self.name));
+        } else if self.children.is_empty() {
+            self.start(out, depth);
+            out.push_str("/>\n");
+        } else {
+            self.open(out, depth);
+            for child in &self.children {
+                child.write(out, depth + 1);
+            }
+            self.close(out, depth);
+        }
+    }
+
+    /// `<name attributes`, indented.
+    fn start(&self, out: &mut String, depth: usize) {
+        out.push_str(&"  ".repeat(depth));
         out.push('<');
         out.push_str(self.name);
         for (key, value) in &self.attributes {
             out.push_str(&format!(" {key}=\"{}\"", escape(value)));
         }
-        if !self.text.is_empty() {
-            out.push_str(&format!(">{}</{}>\n", escape(&self.text), self.name));
-        } else if self.children.is_empty() {
-            out.push_str("/>\n");
-        } else {
-            out.push_str(">\n");
-            for child in &self.children {
-                child.write(out, depth + 1);
-            }
-            out.push_str(&format!("{indent}</{}>\n", self.name));
-        }
+    }
+
+    /// The start tag of an element whose children follow.
+    fn open(&self, out: &mut String, depth: usize) {
+        self.start(out, depth);
+        out.push_str(">\n");
+    }
+
+    fn close(&self, out: &mut String, depth: usize) {
+        out.push_str(&format!("{}</{}>\n", "  ".repeat(depth), self.name));
     }
 }
 
@@ -307,6 +347,13 @@ fn escape(text: &str) -> String {
 mod tests {
     use super::*;
     use crate::output::{describe_if_missing, write_run};
+
+    /// The XDMF text for the run file named `run_file`.
+    fn describe(run_file: &str, layout: &HistoryLayout) -> String {
+        let mut out = Vec::new();
+        write_description(&mut out, run_file, layout).unwrap();
+        String::from_utf8(out).unwrap()
+    }
 
     /// A small run of `yaml`'s first configuration, written into `dir`.
     fn written_run(dir: &Path, yaml: &str) -> (RunRecord, PathBuf) {

@@ -20,6 +20,8 @@ mod tests;
 
 use nalgebra::SVector;
 
+use crate::fallible::filled;
+
 pub use basis::{monomials, Degree, MAX_TERMS};
 pub use consistent_mass::ConsistentMassTransfer;
 pub use gauss::gauss_legendre_rule;
@@ -58,10 +60,10 @@ const EMPTY_NODE_FRACTION: f64 = 1e-12;
 impl<const D: usize> GridState<D> {
     pub fn new(nodes: usize, particle_mass: f64) -> Self {
         GridState {
-            mass: vec![0.0; nodes],
-            velocity: vec![SVector::zeros(); nodes],
-            force: vec![SVector::zeros(); nodes],
-            velocity_new: vec![SVector::zeros(); nodes],
+            mass: filled(nodes, 0.0, "the nodal masses"),
+            velocity: filled(nodes, SVector::zeros(), "the nodal velocities"),
+            force: filled(nodes, SVector::zeros(), "the nodal forces"),
+            velocity_new: filled(nodes, SVector::zeros(), "the nodal velocities"),
             empty_mass: EMPTY_NODE_FRACTION * particle_mass,
         }
     }

@@ -12,6 +12,7 @@ use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use super::needs_run;
 use crate::experiment::RunSpec;
 use crate::output::{run_path, this_host, TempHost, TempWriter};
 
@@ -109,14 +110,14 @@ impl<'a> Claims<'a> {
         }
     }
 
-    /// Whether this process computes `run`: it took the run's lock, and the run has no file
-    /// yet (unless `force`). A lock that cannot be taken at all leaves the run to this process,
+    /// Whether this process computes `run`: it took the run's lock, and the run still needs
+    /// computing (`needs_run`). A lock that cannot be taken at all leaves the run to this process,
     /// unlocked; writing it then reports what is wrong with the directory.
     pub fn take(&self, run: &'a RunSpec) -> bool {
         match claim(&self.dir, &run.run_id, false) {
             Ok(Claim::Held(lock)) => {
                 // Another process may have written it since this one looked.
-                if !self.force && run_path(&self.dir, &run.run_id).exists() {
+                if !needs_run(&self.dir, &run.run_id, self.force) {
                     *lock_of(&self.elsewhere) += 1;
                     return false;
                 }

@@ -188,9 +188,16 @@ fn corner_offset<const D: usize>(a: usize, b: usize) -> usize {
 ///
 /// This evaluates the run's basis at arbitrary points, e.g. the Gauss points of a quadrature
 /// transfer, through `Stencils::update`.
+impl<const D: usize> DualDomain<D> {
+    /// The nodes of every point's stencil: the block of 4 per axis around its cell.
+    pub fn stencil_nodes() -> usize {
+        NODES_PER_AXIS.pow(D as u32)
+    }
+}
+
 impl<const D: usize> Shape<D> for DualDomain<D> {
     fn nodes_per_point(&self) -> usize {
-        NODES_PER_AXIS.pow(D as u32)
+        Self::stencil_nodes()
     }
 
     fn eval(

@@ -1,5 +1,7 @@
 use nalgebra::SVector;
 
+use crate::fallible::filled;
+
 use super::{Grid, Shape};
 
 /// Shape-function values of every particle, `per_point` entries each, stored flat so
@@ -13,12 +15,12 @@ pub struct Stencils<const D: usize> {
 
 impl<const D: usize> Stencils<D> {
     pub fn new(per_point: usize, particles: usize) -> Self {
-        let n = per_point * particles;
+        let n = per_point.saturating_mul(particles);
         Stencils {
             per_point,
-            node: vec![0; n],
-            weight: vec![0.0; n],
-            grad: vec![SVector::zeros(); n],
+            node: filled(n, 0, "the stencils' nodes"),
+            weight: filled(n, 0.0, "the stencils' values"),
+            grad: filled(n, SVector::zeros(), "the stencils' gradients"),
         }
     }
 

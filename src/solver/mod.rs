@@ -2,6 +2,7 @@
 //! reconstruction benchmarks, which do not step, go to `reconstruction`, and those of the
 //! shape-function benchmark to `shape_functions`.
 
+mod footprint;
 mod reconstruction;
 mod recorder;
 mod reference;
@@ -25,12 +26,25 @@ use crate::shape::{
     Stencils,
 };
 
+pub use footprint::estimated_bytes;
 use recorder::{GridSample, Recorder};
 use transfer::Transfer;
 
-/// Runs one configuration. Never panics on bad numbers: a run that cannot start is
-/// `failed`, a run that blows up is `diverged`, each with the reason in `message`.
+/// Runs one configuration, keeping its whole history in the record. Never panics on bad
+/// numbers: a run that cannot start is `failed`, a run that blows up is `diverged`, each with
+/// the reason in `message`.
 pub fn simulate(spec: &RunSpec) -> RunRecord {
+    simulate_with(spec, None)
+}
+
+/// The same, streaming the history of a simulation into `file` as it is sampled (the
+/// record's `stream`), so that its memory does not grow with the samples; `write_record`
+/// completes the file.
+pub fn simulate_into(spec: &RunSpec, file: &hdf5::File) -> RunRecord {
+    simulate_with(spec, Some(file))
+}
+
+fn simulate_with(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
     let started = Instant::now();
     let kind = benchmarks::info(&spec.benchmark).map(benchmarks::kind);
     let mut record = if kind.is_some_and(BenchmarkKind::is_reconstruction) {
@@ -38,19 +52,19 @@ pub fn simulate(spec: &RunSpec) -> RunRecord {
     } else if kind == Some(BenchmarkKind::ShapeFunctions) {
         shape_functions::evaluate(spec)
     } else if crate::reference::method(&spec.method).is_some() {
-        reference::solve(spec)
+        reference::solve(spec, file)
     } else {
-        step(spec)
+        step(spec, file)
     };
     record.wall_seconds = started.elapsed().as_secs_f64();
     record
 }
 
 /// A simulation: the problem stepped to its final time by the method.
-fn step(spec: &RunSpec) -> RunRecord {
+fn step(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
     match prepare(spec) {
-        Ok((method, AnyProblem::D1(problem))) => Run::new(spec, method, problem).execute(),
-        Ok((method, AnyProblem::D2(problem))) => Run::new(spec, method, problem).execute(),
+        Ok((method, AnyProblem::D1(problem))) => Run::new(spec, method, problem, file).execute(),
+        Ok((method, AnyProblem::D2(problem))) => Run::new(spec, method, problem, file).execute(),
         Err(message) => base_record(spec, message),
     }
 }
@@ -134,7 +148,12 @@ struct Run<'a, const D: usize> {
 }
 
 impl<'a, const D: usize> Run<'a, D> {
-    fn new(spec: &'a RunSpec, method: Method, mut problem: Box<dyn Problem<D>>) -> Self {
+    fn new(
+        spec: &'a RunSpec,
+        method: Method,
+        mut problem: Box<dyn Problem<D>>,
+        file: Option<&hdf5::File>,
+    ) -> Self {
         let dofs = match method.shape {
             ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
             ShapeKind::Linear
@@ -149,31 +168,26 @@ impl<'a, const D: usize> Run<'a, D> {
         let mut recorder = Recorder::new();
         recorder.attach_probes(problem.as_ref(), &particles.x0);
         recorder.attach_grid(&grid);
+        if let Some(file) = file {
+            recorder.stream_to(file, particles.len());
+        }
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
-        let (basis, per_point) = match method.shape {
-            ShapeKind::Linear => (Basis::Hat, Shape::<D>::nodes_per_point(&LinearHat)),
-            ShapeKind::Domain(shape) => (
-                Basis::Domains(ParticleDomains::new(shape, &particles)),
-                ParticleDomains::<D>::nodes_per_point(),
-            ),
-            ShapeKind::QuadraticBSpline => (
-                Basis::BSpline,
-                Shape::<D>::nodes_per_point(&QuadraticBSpline),
-            ),
+        let basis = match method.shape {
+            ShapeKind::Linear => Basis::Hat,
+            ShapeKind::Domain(shape) => Basis::Domains(ParticleDomains::new(shape, &particles)),
+            ShapeKind::QuadraticBSpline => Basis::BSpline,
             ShapeKind::DualDomain(integrals) => {
-                let dual = DualDomain::new(&grid, integrals);
-                let per_point = dual.nodes_per_point();
-                (Basis::DualDomain(dual), per_point)
+                Basis::DualDomain(DualDomain::new(&grid, integrals))
             }
             ShapeKind::LocalMaxEnt(settings) => {
                 // `methods::resolve` has checked gamma and the cut-off for this dimension.
                 let lme = LocalMaxEnt::with_tolerance(settings.gamma, settings.tolerance)
                     .expect("LME parameters are validated before a run starts");
-                let per_point = lme.nodes_per_point();
-                (Basis::LocalMaxEnt(lme), per_point)
+                Basis::LocalMaxEnt(lme)
             }
         };
+        let per_point = footprint::stencil_nodes::<D>(method.shape);
         Run {
             spec,
             method,
@@ -538,6 +552,7 @@ fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord 
     record.errors = run.recorder.errors;
     record.conservation = run.recorder.conservation;
     record.probes = run.recorder.probes;
+    record.stream = run.recorder.stream;
     record.diagnostics = run.diagnostics;
     record
 }
@@ -560,6 +575,11 @@ fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<Fix
         }
     }
     fixed
+}
+
+/// The record of a run that failed with `message` before it computed anything.
+pub fn failed_record(spec: &RunSpec, message: String) -> RunRecord {
+    base_record(spec, message)
 }
 
 /// A record with the run's identity and status `failed`; a run that starts fills in the rest.
@@ -590,6 +610,7 @@ fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         reconstruction: None,
         elements: None,
         shape_functions: None,
+        stream: None,
     }
 }
 
@@ -630,7 +651,7 @@ mod tests {
             (method, AnyProblem::D1(problem)) => (method, problem),
             _ => unreachable!("mms1d_tran is 1D"),
         };
-        let mut run = Run::new(spec, method, problem);
+        let mut run = Run::new(spec, method, problem, None);
         let dt = run.problem.dt();
         let grid_solve = |run: &mut Run<1>, s: usize| grid_step(run, s as f64 * dt, dt);
         // At t = 0 the stress and the body force vanish, so every integrator agrees; the
@@ -696,7 +717,7 @@ mod tests {
                 (method, AnyProblem::D1(problem)) => (method, problem),
                 _ => unreachable!("the vibrating bar is 1D"),
             };
-            let mut run = Run::new(spec, method, problem);
+            let mut run = Run::new(spec, method, problem, None);
             // The grid [0, 1] with the body shrunk to its middle, free at both ends.
             run.fixed.clear();
             run.transfer = Transfer::new(&method.transfer, &run.grid, run.basis.shape(), &[]);

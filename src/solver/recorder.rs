@@ -1,12 +1,17 @@
 use nalgebra::SVector;
 
 use crate::benchmarks::{ProbeQuantity, Problem};
-use crate::output::{Conservation, Errors, GridHistory, History, ProbeRecord, REFERENCE_KINDS};
+use crate::output::{
+    Conservation, Errors, GridHistory, History, HistoryStream, ProbeRecord, StreamShape,
+    REFERENCE_KINDS,
+};
 use crate::particles::Particles;
 use crate::shape::Grid;
 
 /// Appends sampled particle states and grid velocities, their errors against the exact
-/// solution and the mass totals, and every step the values at the problem's probes.
+/// solution and the mass totals, and every step the values at the problem's probes. With a
+/// stream (`stream_to`) the arrays that grow with the samples and steps go to the run file as
+/// they are recorded, and only the per-sample totals and norms stay in memory.
 pub struct Recorder<const D: usize> {
     pub history: History,
     pub grid: GridHistory,
@@ -17,6 +22,9 @@ pub struct Recorder<const D: usize> {
     quantities: Vec<ProbeQuantity>,
     /// Where the DOFs of the grid sit (none until `attach_grid`).
     dofs: Vec<SVector<f64, D>>,
+    /// The run file's stream, or why writing to it failed (after which what is recorded is
+    /// dropped, so memory stays bounded, and the run's file is not written).
+    pub stream: Option<Result<HistoryStream, String>>,
 }
 
 /// What a sample records of the grid: the total nodal mass the transfer of the step
@@ -38,6 +46,61 @@ impl<const D: usize> Recorder<D> {
             probes: Vec::new(),
             quantities: Vec::new(),
             dofs: Vec::new(),
+            stream: None,
+        }
+    }
+
+    /// Streams the growing arrays of `particles` particles into `file` from now on (once,
+    /// after `attach_grid` and `attach_probes`, before the first record).
+    pub fn stream_to(&mut self, file: &hdf5::File, particles: usize) {
+        let shape = StreamShape {
+            dim: D,
+            particles,
+            dofs: self.dofs.len(),
+        };
+        self.stream =
+            Some(HistoryStream::create(file, shape, &self.probes).map_err(|e| e.to_string()));
+    }
+
+    /// Moves the last sample's per-particle and per-DOF arrays to the stream, if there is one.
+    fn drain_sample(&mut self) {
+        let Some(stream) = &mut self.stream else {
+            return;
+        };
+        if let Ok(open) = stream {
+            if let Err(e) = open.append_samples(1, &self.history, &self.grid, &self.errors) {
+                *stream = Err(e.to_string());
+            }
+        }
+        let h = &mut self.history;
+        for values in [&mut h.x, &mut h.v, &mut h.stress, &mut h.density] {
+            values.clear();
+        }
+        self.grid.v.clear();
+        let e = &mut self.errors;
+        for values in [&mut e.volume, &mut e.grid_velocity.pointwise]
+            .into_iter()
+            .chain(&mut e.pointwise)
+        {
+            values.clear();
+        }
+    }
+
+    /// Moves the probes' last step to the stream, if there is one.
+    fn drain_probes(&mut self) {
+        let Some(stream) = &mut self.stream else {
+            return;
+        };
+        if let Ok(open) = stream {
+            if let Err(e) = open.append_probes(&self.probes) {
+                *stream = Err(e.to_string());
+            }
+        }
+        for probe in &mut self.probes {
+            probe.time.clear();
+            probe.step.clear();
+            probe.value.clear();
+            probe.reference.clear();
         }
     }
 
@@ -123,6 +186,7 @@ impl<const D: usize> Recorder<D> {
             probe.value.push(value);
             probe.reference.push(reference);
         }
+        self.drain_probes();
     }
 
     /// Records the state at step `step`, time `t`, with `velocity` synchronised to `t`, and
@@ -154,6 +218,7 @@ impl<const D: usize> Recorder<D> {
         let particle_mass = particles.mass.iter().sum();
         self.conservation.particle_mass.push(particle_mass);
         self.conservation.grid_mass.push(grid.mass);
+        self.drain_sample();
     }
 
     /// The grid velocity of the step sampled at time `t` and its error at each DOF x_a: the

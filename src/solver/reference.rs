@@ -12,23 +12,26 @@ use crate::reference::{self, UlFem};
 
 /// Runs `spec`, whose method is a reference method; a benchmark it does not solve makes the
 /// run `failed` with the reason.
-pub(super) fn solve(spec: &RunSpec) -> RunRecord {
+pub(super) fn solve(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
     if let Some(reason) = reference::unsupported(&spec.method, &spec.benchmark) {
         return base_record(spec, reason);
     }
     match benchmarks::build(&spec.benchmark, &spec.params) {
-        Ok(AnyProblem::D1(problem)) => ulfem(spec, problem.as_ref()),
+        Ok(AnyProblem::D1(problem)) => ulfem(spec, problem.as_ref(), file),
         Ok(AnyProblem::D2(_)) => base_record(spec, format!("{} is 1D only", spec.method)),
         Err(e) => base_record(spec, e.to_string()),
     }
 }
 
-fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>) -> RunRecord {
+fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>, file: Option<&hdf5::File>) -> RunRecord {
     let dt = problem.dt();
     let planned = problem.steps();
     let every = spec.output_every;
     let mut fem = UlFem::new(problem);
     let mut recorder = Recorder::new();
+    if let Some(file) = file {
+        recorder.stream_to(file, fem.elements());
+    }
     let mut velocity = vec![SVector::zeros(); fem.elements()];
     let mut outcome = Ok(());
     let mut steps = planned;

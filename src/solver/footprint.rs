@@ -1,0 +1,119 @@
+//! What a run will hold in memory, estimated from its parameters before it starts, so that the
+//! runner can refuse a run that cannot fit and hold back runs that would not fit beside those
+//! running. The terms are the arrays that scale with the run: the particle state and stencils,
+//! one sample of the history (kept until it is streamed, and in the stream's buffers), the
+//! grid, the transfer's evaluation points and their least-squares neighbourhoods, and the
+//! banded consistent mass matrix; a fixed allowance covers the HDF5 library and the stream's
+//! chunk buffers. The history itself is on disk (`output::HistoryStream`), so the estimate
+//! does not grow with the number of samples.
+
+use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
+use crate::experiment::RunSpec;
+use crate::methods::{self, Method, ShapeKind, TransferKind};
+use crate::params::get_usize;
+use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe};
+use crate::shape::{
+    Dofs, DualDomain, Grid, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape,
+};
+
+/// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
+/// growing dataset).
+const FIXED_BYTES: f64 = 48.0 * 1024.0 * 1024.0;
+/// Bytes per point of an unstepped run (reconstructions, shape functions): its position,
+/// value, fit and errors.
+const UNSTEPPED_BYTES_PER_POINT: f64 = 512.0;
+
+/// The estimated peak memory of `spec` in bytes.
+pub fn estimated_bytes(spec: &RunSpec) -> f64 {
+    let info = benchmarks::info(&spec.benchmark);
+    let dim = info.map_or(1, |b| b.dim) as i32;
+    let int = |key: &str| get_usize(&spec.params, key).unwrap_or(1) as f64;
+    let unstepped = info.is_none_or(|b| benchmarks::kind(b) != BenchmarkKind::Simulation);
+    let body_particles = (int("cells") * int("ppc")).powi(dim);
+    if unstepped || crate::reference::method(&spec.method).is_some() {
+        return FIXED_BYTES + body_particles * UNSTEPPED_BYTES_PER_POINT;
+    }
+    let method = methods::preset(&spec.method)
+        .and_then(|preset| methods::resolve(preset, &spec.params, dim as usize).ok());
+    let (Some(method), Ok(problem)) = (method, benchmarks::build(&spec.benchmark, &spec.params))
+    else {
+        return FIXED_BYTES;
+    };
+    let ppc = int("ppc");
+    FIXED_BYTES
+        + match problem {
+            AnyProblem::D1(p) => simulation_bytes(p.as_ref(), &method, body_particles, ppc),
+            AnyProblem::D2(p) => simulation_bytes(p.as_ref(), &method, body_particles, ppc),
+        }
+}
+
+/// The arrays of a simulation of `particles` particles, `ppc` per cell and axis.
+fn simulation_bytes<const D: usize>(
+    problem: &dyn Problem<D>,
+    method: &Method,
+    particles: f64,
+    ppc: f64,
+) -> f64 {
+    let d = D as f64;
+    let dofs = match method.shape {
+        ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
+        _ => Dofs::Nodes,
+    };
+    let grid = Grid::with_dofs(&problem.domain(), dofs);
+    let cells = grid.cells as f64;
+    let nodes = grid.num_nodes() as f64;
+    let stencil = stencil_nodes::<D>(method.shape) as f64;
+    let stencil_bytes = |points: f64| points * stencil * (4.0 + 8.0 + 8.0 * d);
+    // x0, x, v, F, stress, J, mass, volumes; body force, synchronised velocity, cell; the
+    // predictor-corrector's acceleration and prediction; a particle domain's corners.
+    let state = 8.0 * (6.0 * d + 2.0 * d * d + 5.0 + 2.0 * d)
+        + match method.shape {
+            ShapeKind::Domain(_) => 2.0 * 8.0 * d * 2f64.powi(D as i32),
+            _ => 0.0,
+        };
+    // Positions, velocities, stress, density, volume and four error fields, twice.
+    let sample = 2.0 * 8.0 * (2.0 * d + d * d + 6.0);
+    let per_node = 8.0 * (7.0 * d + 3.0);
+    let gauss_points = |per_axis: usize| (cells * per_axis as f64).powi(D as i32);
+    let neighbours =
+        |recipe: &Recipe| (ppc * (2.0 * recipe.kernel.radius_cells().ceil() + 1.0)).powi(D as i32);
+    let fit_bytes = |points: f64, recipe: &Recipe| points * (24.0 * neighbours(recipe) + 512.0);
+    let span = stencil.powf(1.0 / d);
+    let banded = (d + 1.0) * nodes * (span * (cells + 2.0).powi(D as i32 - 1) + 1.0) * 8.0;
+    let transfer = match &method.transfer {
+        TransferKind::Shepard => 0.0,
+        TransferKind::FittedVelocity(recipe) => fit_bytes(nodes, recipe),
+        TransferKind::ConsistentMass => banded,
+        TransferKind::Quadrature(recipe) => {
+            let points = gauss_points(recipe.gauss_points);
+            let velocity = match &recipe.velocity {
+                NodalVelocity::Fit(fit) => fit_bytes(nodes, fit),
+                NodalVelocity::Shepard => 0.0,
+            };
+            velocity + fit_bytes(points, &recipe.fields) + stencil_bytes(points) + 96.0 * points
+        }
+        TransferKind::Taylor(recipe) => {
+            let points = gauss_points(recipe.gauss_points);
+            let mass = match recipe.mass {
+                MassMatrix::Consistent => banded,
+                MassMatrix::Lumped => 0.0,
+            };
+            mass + stencil_bytes(points) + 256.0 * points + 1024.0 * cells.powi(D as i32)
+        }
+    };
+    particles * (state + sample) + stencil_bytes(particles) + nodes * per_node + transfer
+}
+
+/// The nodes each particle's stencil holds for the method's basis.
+pub fn stencil_nodes<const D: usize>(shape: ShapeKind) -> usize {
+    match shape {
+        ShapeKind::Linear => Shape::<D>::nodes_per_point(&LinearHat),
+        ShapeKind::Domain(_) => ParticleDomains::<D>::nodes_per_point(),
+        ShapeKind::QuadraticBSpline => Shape::<D>::nodes_per_point(&QuadraticBSpline),
+        ShapeKind::DualDomain(_) => DualDomain::<D>::stencil_nodes(),
+        ShapeKind::LocalMaxEnt(settings) => {
+            LocalMaxEnt::<D>::with_tolerance(settings.gamma, settings.tolerance)
+                .map_or(1, |lme| lme.nodes_per_point())
+        }
+    }
+}
