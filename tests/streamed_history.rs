@@ -1,7 +1,8 @@
 //! A run computed into its file, its history streamed there as it is sampled, gives the same
 //! file as the run kept in memory and written whole: every dataset, shape and attribute, bit
-//! for bit (but the wall time). Checked on runs of every kind of the reduced matrices, and on
-//! histories of many samples, which span several chunks of the streamed datasets.
+//! for bit (but the wall time), and not much larger than its numbers. Checked on runs of every
+//! kind of the reduced matrices, and on histories of many samples, which span several chunks of
+//! the streamed datasets.
 
 use std::path::Path;
 
@@ -91,6 +92,23 @@ fn check(spec: &RunSpec) -> usize {
     for ((name, x), (_, y)) in a.iter().zip(&b) {
         assert!(x == y, "{}: {name} differs", spec.run_id);
     }
+    // Chunks fit the planned samples: a file is not much larger than its numbers.
+    let numbers: usize = b
+        .iter()
+        .map(|(_, stored)| match stored {
+            Stored::Floats(_, values) => 8 * values.len(),
+            Stored::Ints(_, values) => 8 * values.len(),
+            Stored::Text(text) => text.len(),
+        })
+        .sum();
+    let size = std::fs::metadata(run_path(dir.path(), &spec.run_id))
+        .unwrap()
+        .len() as usize;
+    assert!(
+        size <= 2 * numbers + (1 << 20),
+        "{}: {size} bytes for {numbers}",
+        spec.run_id
+    );
     a.len()
 }
 

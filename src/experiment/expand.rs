@@ -235,15 +235,25 @@ fn placement_conflict(method: &str, params: &Params) -> Option<ParamError> {
     })
 }
 
+/// The history samples of a run of `steps` steps: t = 0, every `every`-th step and the final
+/// time (every = 0: the first and last states only).
+pub fn sample_count(steps: usize, every: usize) -> usize {
+    if steps == 0 {
+        return 1;
+    }
+    let between = match every {
+        0 => 0,
+        every => steps / every - usize::from(steps.is_multiple_of(every)),
+    };
+    2 + between
+}
+
 /// A run samples its history at t = 0, every `every`-th step and the final time (every = 0:
 /// the first and last states only); at most `MAX_SAMPLES` times.
 fn check_samples(steps: usize, sampling: &Sampling, chosen: &[Chosen]) -> Result<(), ConfigError> {
     let every = sampling.every;
-    if every == 0 {
-        return Ok(());
-    }
-    let samples = 1 + steps / every + usize::from(!steps.is_multiple_of(every));
-    if samples <= MAX_SAMPLES {
+    let samples = sample_count(steps, every);
+    if every == 0 || samples <= MAX_SAMPLES {
         return Ok(());
     }
     Err(ConfigError::at(
@@ -311,6 +321,19 @@ mod tests {
     use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
     use crate::params::ParamValue;
+
+    /// The samples the step loop takes (s = 0, s = steps, and s % every == 0), counted.
+    #[test]
+    fn sample_count_counts_what_the_step_loop_samples() {
+        for steps in 0..40 {
+            for every in 0..12 {
+                let taken = (0..=steps)
+                    .filter(|&s| s == 0 || s == steps || (every > 0 && s % every == 0))
+                    .count();
+                assert_eq!(sample_count(steps, every), taken, "{steps} {every}");
+            }
+        }
+    }
 
     /// A benchmark whose check rejects its own default, which no real benchmark does.
     const TOY: BenchmarkInfo = BenchmarkInfo {

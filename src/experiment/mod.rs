@@ -27,7 +27,7 @@ use crate::params::Params;
 
 pub use document::MAX_NAME_LEN;
 pub use error::ConfigError;
-pub use expand::{MAX_RUNS, MAX_SAMPLES};
+pub use expand::{sample_count, MAX_RUNS, MAX_SAMPLES};
 pub use run_id::MAX_RUN_ID_LEN;
 pub use select::{Allowed, Selection};
 pub use values::MAX_LIST_VALUES;

@@ -36,7 +36,14 @@ struct Appender<T> {
 }
 
 impl<T: H5Type + Copy> Appender<T> {
-    fn new(group: &Group, name: &str, row_shape: &[usize], unit: &'static str) -> Self {
+    /// A dataset of at most `rows` rows (the planned number; a diverged run writes fewer).
+    fn new(
+        group: &Group,
+        name: &str,
+        row_shape: &[usize],
+        unit: &'static str,
+        rows: usize,
+    ) -> Self {
         let row = row_shape.iter().product::<usize>();
         Appender {
             group: group.clone(),
@@ -46,7 +53,7 @@ impl<T: H5Type + Copy> Appender<T> {
             row,
             dataset: None,
             rows_written: 0,
-            chunk_rows: (CHUNK_VALUES / row.max(1)).max(1),
+            chunk_rows: (CHUNK_VALUES / row.max(1)).min(rows).max(1),
             buffer: Vec::new(),
         }
     }
@@ -122,32 +129,39 @@ impl<T: H5Type + Copy> Appender<T> {
         Ok(dataset)
     }
 
-    /// Writes what is buffered; a dataset never written gets its final, possibly empty, shape.
+    /// Writes what is buffered. A dataset that fits in one chunk was never written: it is
+    /// written whole here, contiguous, as a record kept in memory would be.
     fn finish(mut self) -> hdf5::Result<()> {
-        if !self.buffer.is_empty() {
-            return self.write_buffer();
-        }
         if self.dataset.is_some() {
-            return Ok(());
+            return match self.buffer.is_empty() {
+                true => Ok(()),
+                false => self.write_buffer(),
+            };
         }
-        let shape: Vec<usize> = std::iter::once(self.rows_written)
+        let rows = self.rows_written + self.buffer.len() / self.row.max(1);
+        let shape: Vec<usize> = std::iter::once(rows)
             .chain(self.row_shape.iter().copied())
             .collect();
+        let view = ArrayView::from_shape(IxDyn(&shape), &self.buffer)
+            .map_err(|e| hdf5::Error::from(format!("{}: {e}", self.name)))?;
         let dataset = self
             .group
-            .new_dataset::<T>()
-            .shape(shape.as_slice())
+            .new_dataset_builder()
+            .with_data(view)
             .create(self.name.as_str())?;
         attr_str(&dataset, "units", self.unit)
     }
 }
 
-/// The sizes a stream's rows have: the dimension, the particles and the grid's DOFs.
+/// The sizes a stream's rows have (the dimension, the particles and the grid's DOFs), and how
+/// many rows it plans: the history samples and the probes' steps.
 #[derive(Clone, Copy, Debug)]
 pub struct StreamShape {
     pub dim: usize,
     pub particles: usize,
     pub dofs: usize,
+    pub samples: usize,
+    pub steps: usize,
 }
 
 /// The growing arrays of one run file: per sample the particle states, the grid velocity and
@@ -188,12 +202,20 @@ impl HistoryStream {
             dim: d,
             particles: np,
             dofs: nn,
+            samples: nt,
+            steps,
         } = shape;
         let history = file.create_group("history")?;
         let grid = file.create_group("grid")?;
         let errors = file.create_group("errors")?;
         let field = |name: &'static str, points: usize| {
-            Appender::new(&errors, name, &[points], super::writer::field_unit(name))
+            Appender::new(
+                &errors,
+                name,
+                &[points],
+                super::writer::field_unit(name),
+                nt,
+            )
         };
         let probe_group = if probe_records.is_empty() {
             None
@@ -204,16 +226,16 @@ impl HistoryStream {
             None => Vec::new(),
             Some(group) => probe_records
                 .iter()
-                .map(|probe| ProbeStream::create(group, probe))
+                .map(|probe| ProbeStream::create(group, probe, steps))
                 .collect::<hdf5::Result<_>>()?,
         };
         Ok(HistoryStream {
-            x: Appender::new(&history, "x", &[np, d], "m"),
-            v: Appender::new(&history, "v", &[np, d], "m/s"),
-            stress: Appender::new(&history, "stress", &[np, d, d], "Pa"),
-            density: Appender::new(&history, "density", &[np], "kg/m^D"),
-            grid_v: Appender::new(&grid, "v", &[nn, d], "m/s"),
-            volume: Appender::new(&errors, "volume", &[np], "m^D"),
+            x: Appender::new(&history, "x", &[np, d], "m", nt),
+            v: Appender::new(&history, "v", &[np, d], "m/s", nt),
+            stress: Appender::new(&history, "stress", &[np, d, d], "Pa", nt),
+            density: Appender::new(&history, "density", &[np], "kg/m^D", nt),
+            grid_v: Appender::new(&grid, "v", &[nn, d], "m/s", nt),
+            volume: Appender::new(&errors, "volume", &[np], "m^D", nt),
             pointwise: std::array::from_fn(|f| field(ERROR_FIELDS[f], np)),
             grid_velocity: field(GRID_VELOCITY, nn),
             probes,
@@ -287,13 +309,15 @@ impl HistoryStream {
 }
 
 impl ProbeStream {
-    fn create(group: &Group, probe: &ProbeRecord) -> hdf5::Result<Self> {
+    /// The probe's group and datasets, of at most `steps` + 1 rows.
+    fn create(group: &Group, probe: &ProbeRecord, steps: usize) -> hdf5::Result<Self> {
         let g = group.create_group(&probe.name)?;
+        let rows = steps + 1;
         Ok(ProbeStream {
-            time: Appender::new(&g, probes::TIME, &[], "s"),
-            step: Appender::new(&g, probes::STEP, &[], "1"),
-            value: Appender::new(&g, probes::VALUE, &[], probe.unit()),
-            reference: Appender::new(&g, probes::REFERENCE, &[], probe.unit()),
+            time: Appender::new(&g, probes::TIME, &[], "s", rows),
+            step: Appender::new(&g, probes::STEP, &[], "1", rows),
+            value: Appender::new(&g, probes::VALUE, &[], probe.unit(), rows),
+            reference: Appender::new(&g, probes::REFERENCE, &[], probe.unit(), rows),
             tally: WiggleTally::default(),
         })
     }

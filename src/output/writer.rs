@@ -45,10 +45,13 @@ pub fn write_record(
     let stream = match stream {
         Some(stream) => stream,
         None => {
+            let steps = r.probes.first().map_or(0, |p| p.time.len());
             let shape = StreamShape {
                 dim: d,
                 particles: np,
                 dofs: nn,
+                samples: nt,
+                steps,
             };
             let mut stream = HistoryStream::create(file, shape, &r.probes)?;
             stream.append_samples(nt, &r.history, &r.grid, &r.errors)?;

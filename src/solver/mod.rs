@@ -169,7 +169,7 @@ impl<'a, const D: usize> Run<'a, D> {
         recorder.attach_probes(problem.as_ref(), &particles.x0);
         recorder.attach_grid(&grid);
         if let Some(file) = file {
-            recorder.stream_to(file, particles.len());
+            recorder.stream_to(file, particles.len(), problem.steps(), spec.output_every);
         }
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);

@@ -1,6 +1,7 @@
 use nalgebra::SVector;
 
 use crate::benchmarks::{ProbeQuantity, Problem};
+use crate::experiment::sample_count;
 use crate::output::{
     Conservation, Errors, GridHistory, History, HistoryStream, ProbeRecord, StreamShape,
     REFERENCE_KINDS,
@@ -51,12 +52,15 @@ impl<const D: usize> Recorder<D> {
     }
 
     /// Streams the growing arrays of `particles` particles into `file` from now on (once,
-    /// after `attach_grid` and `attach_probes`, before the first record).
-    pub fn stream_to(&mut self, file: &hdf5::File, particles: usize) {
+    /// after `attach_grid` and `attach_probes`, before the first record), for a run of
+    /// `steps` steps sampled every `every`.
+    pub fn stream_to(&mut self, file: &hdf5::File, particles: usize, steps: usize, every: usize) {
         let shape = StreamShape {
             dim: D,
             particles,
             dofs: self.dofs.len(),
+            samples: sample_count(steps, every),
+            steps,
         };
         self.stream =
             Some(HistoryStream::create(file, shape, &self.probes).map_err(|e| e.to_string()));

@@ -30,7 +30,7 @@ fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>, file: Option<&hdf5::File>) ->
     let mut fem = UlFem::new(problem);
     let mut recorder = Recorder::new();
     if let Some(file) = file {
-        recorder.stream_to(file, fem.elements());
+        recorder.stream_to(file, fem.elements(), planned, every);
     }
     let mut velocity = vec![SVector::zeros(); fem.elements()];
     let mut outcome = Ok(());
