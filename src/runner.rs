@@ -21,7 +21,7 @@ use crate::output::{
     write_run, RunRecord, RunStatus,
 };
 use crate::params::get_usize;
-use crate::solver::{estimated_bytes, failed_record, simulate_into};
+use crate::solver::{base_record, estimated_bytes, simulate_into};
 
 pub use memory::{parse_size, MemoryBudget, REFUSED};
 
@@ -183,7 +183,7 @@ fn execute(
 
 /// Writes the file of a run that failed with `message` before or while it ran.
 fn record_failure(dir: &Path, run: &RunSpec, message: String) -> io::Result<(RunStatus, String)> {
-    match write_run(dir, &failed_record(run, message.clone())) {
+    match write_run(dir, &base_record(run, message.clone())) {
         Ok(_) => Ok((RunStatus::Failed, message)),
         Err(e) => Err(io::Error::other(format!(
             "{message}; nor could the failure be recorded: {e}"

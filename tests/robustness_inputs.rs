@@ -243,7 +243,7 @@ fn points_axis(n: usize) -> String {
     )
 }
 
-/// ... and is written: its configuration (about 400 kB of YAML) and its list are datasets,
+/// ... and is written: its configuration (over 64 KiB of YAML) and its list are datasets,
 /// which an attribute of at most 64 KiB could not hold, and read back whole.
 #[test]
 fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {

@@ -7,7 +7,7 @@ use hdf5::{Dataset, Extent, Group, H5Type, Hyperslab, SimpleExtents, SliceOrInde
 use ndarray::{ArrayView, IxDyn};
 
 use super::probes::{self, WiggleTally};
-use super::writer::attr_str;
+use super::writer::{attr_str, dataset};
 use super::{Errors, GridHistory, History, ProbeRecord, Wiggles, ERROR_FIELDS, GRID_VELOCITY};
 
 /// About 1 MiB of float64 per chunk: large enough that a write per chunk costs little, small
@@ -83,15 +83,15 @@ impl<T: H5Type + Copy> Appender<T> {
 
     fn write_buffer(&mut self) -> hdf5::Result<()> {
         let rows = self.buffer.len() / self.row;
-        let dataset = match &self.dataset {
-            Some(dataset) => dataset,
+        let target = match &self.dataset {
+            Some(target) => target,
             None => self.dataset.insert(self.create()?),
         };
         let total = self.rows_written + rows;
         let shape: Vec<usize> = std::iter::once(total)
             .chain(self.row_shape.iter().copied())
             .collect();
-        dataset.resize(shape.as_slice())?;
+        target.resize(shape.as_slice())?;
         let block: Vec<usize> = std::iter::once(rows)
             .chain(self.row_shape.iter().copied())
             .collect();
@@ -100,7 +100,7 @@ impl<T: H5Type + Copy> Appender<T> {
         let selection: Vec<SliceOrIndex> = std::iter::once((self.rows_written..total).into())
             .chain(self.row_shape.iter().map(|_| (..).into()))
             .collect();
-        dataset.write_slice(view, Hyperslab::from(selection))?;
+        target.write_slice(view, Hyperslab::from(selection))?;
         self.rows_written = total;
         self.buffer.clear();
         Ok(())
@@ -119,14 +119,14 @@ impl<T: H5Type + Copy> Appender<T> {
             let parts = row_bytes.div_ceil(MAX_CHUNK_BYTES);
             chunk[1] = chunk[1].div_ceil(parts);
         }
-        let dataset = self
+        let created = self
             .group
             .new_dataset::<T>()
             .shape(SimpleExtents::from_vec(extents))
             .chunk(chunk.as_slice())
             .create(self.name.as_str())?;
-        attr_str(&dataset, "units", self.unit)?;
-        Ok(dataset)
+        attr_str(&created, "units", self.unit)?;
+        Ok(created)
     }
 
     /// Writes what is buffered. A dataset that fits in one chunk was never written: it is
@@ -142,14 +142,7 @@ impl<T: H5Type + Copy> Appender<T> {
         let shape: Vec<usize> = std::iter::once(rows)
             .chain(self.row_shape.iter().copied())
             .collect();
-        let view = ArrayView::from_shape(IxDyn(&shape), &self.buffer)
-            .map_err(|e| hdf5::Error::from(format!("{}: {e}", self.name)))?;
-        let dataset = self
-            .group
-            .new_dataset_builder()
-            .with_data(view)
-            .create(self.name.as_str())?;
-        attr_str(&dataset, "units", self.unit)
+        dataset(&self.group, &self.name, &self.buffer, &shape, self.unit)
     }
 }
 

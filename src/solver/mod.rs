@@ -577,13 +577,9 @@ fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<Fix
     fixed
 }
 
-/// The record of a run that failed with `message` before it computed anything.
-pub fn failed_record(spec: &RunSpec, message: String) -> RunRecord {
-    base_record(spec, message)
-}
-
-/// A record with the run's identity and status `failed`; a run that starts fills in the rest.
-fn base_record(spec: &RunSpec, message: String) -> RunRecord {
+/// A record with the run's identity and status `failed` with `message`: the whole record of a
+/// run that failed before it computed anything; a run that starts fills in the rest.
+pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
     let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
     RunRecord {
         spec: spec.clone(),
