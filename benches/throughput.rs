@@ -2,9 +2,13 @@
 //! bar, one core, with each run's wall time relative to `mpm`'s on the same case in the same
 //! invocation and, on the 2D case, the cost each method should come within; and the cost of
 //! one LME evaluation (its Newton solve) against the hat's.
+//! Beside the times, each run's peak heap per particle (a counting allocator: what the run
+//! allocates above what was live when it started, over its particles).
 //! Run with `cargo bench --bench throughput` (or `make bench`); a bare word filters by method
 //! (`mpm` is timed in any case, as the reference of the ratios).
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use nalgebra::SVector;
@@ -17,6 +21,39 @@ use mpmlab::params::{ParamValue, Params};
 use mpmlab::rng::Lcg;
 use mpmlab::shape::{Grid, LinearHat, LocalMaxEnt, Shape, Stencils};
 use mpmlab::solver::simulate;
+
+/// The system allocator, counting the bytes live and their peak since the last `reset`.
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let ptr = System.alloc(layout);
+        if !ptr.is_null() {
+            let live = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(live, Ordering::Relaxed);
+        }
+        ptr
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout);
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Peak heap bytes of `f` above what was live when it started.
+fn peak_bytes<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let start = LIVE.load(Ordering::Relaxed);
+    PEAK.store(start, Ordering::Relaxed);
+    let out = f();
+    (out, PEAK.load(Ordering::Relaxed) - start)
+}
 
 struct Case {
     benchmark: &'static str,
@@ -212,27 +249,29 @@ fn lme_evaluation_costs() {
 }
 
 /// The best wall time of `spec` over up to three runs (the machine is shared, the minimum is
-/// the least disturbed; runs over ten seconds are timed once), and its record.
-fn timed(spec: &RunSpec) -> (f64, mpmlab::output::RunRecord) {
+/// the least disturbed; runs over ten seconds are timed once), its peak heap and its record.
+fn timed(spec: &RunSpec) -> (f64, usize, mpmlab::output::RunRecord) {
     let mut best = f64::INFINITY;
+    let mut peak = 0;
     let mut record = None;
     for _ in 0..3 {
         if best > 10.0 && record.is_some() {
             break;
         }
         let started = Instant::now();
-        let r = simulate(spec);
+        let (r, bytes) = peak_bytes(|| simulate(spec));
         best = best.min(started.elapsed().as_secs_f64());
+        peak = bytes;
         record = Some(r);
     }
-    (best, record.expect("three runs were made"))
+    (best, peak, record.expect("three runs were made"))
 }
 
 fn main() {
     // Bench harnesses are passed flags such as --bench; a bare word filters by method.
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     println!(
-        "{:<24} {:<14} {:>10} {:>8} {:>10} {:>14} {:>9} {:>7}",
+        "{:<24} {:<14} {:>10} {:>8} {:>10} {:>14} {:>9} {:>7} {:>11}",
         "method",
         "benchmark",
         "particles",
@@ -240,14 +279,15 @@ fn main() {
         "seconds",
         "Mparticle-steps/s",
         "cost/mpm",
-        "target"
+        "target",
+        "B/particle"
     );
     let variants = variants(filter.as_deref());
     for case in CASES {
         let mut mpm_seconds = f64::NAN;
         for variant in &variants {
             let spec = spec(case, variant);
-            let (seconds, record) = timed(&spec);
+            let (seconds, peak, record) = timed(&spec);
             if variant.label == "mpm" {
                 mpm_seconds = seconds;
             }
@@ -264,7 +304,7 @@ fn main() {
             let particles = record.particles.len();
             let rate = (particles * record.steps) as f64 / seconds / 1e6;
             println!(
-                "{:<24} {:<14} {:>10} {:>8} {:>10.3} {:>14.1} {:>9.2} {:>7}",
+                "{:<24} {:<14} {:>10} {:>8} {:>10.3} {:>14.1} {:>9.2} {:>7} {:>11.0}",
                 variant.label,
                 case.benchmark,
                 particles,
@@ -272,7 +312,8 @@ fn main() {
                 seconds,
                 rate,
                 seconds / mpm_seconds,
-                target(&variant.label, case.benchmark)
+                target(&variant.label, case.benchmark),
+                peak as f64 / particles as f64
             );
         }
     }

@@ -47,42 +47,51 @@ impl BandMatrix {
         self.band[k] += value;
     }
 
-    /// Overwrites the matrix with its Cholesky factor L (A = L L^T), in place.
+    /// Overwrites the matrix with its Cholesky factor L (A = L L^T), in place. Right-looking:
+    /// once column k of L is known it is subtracted from the trailing block, so every entry
+    /// receives its terms L_ik L_jk in ascending k, as the dot products of the textbook
+    /// left-looking form subtract them (the same bits), but the updates of one row are
+    /// independent and contiguous instead of one dependent chain.
     pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
         let b = self.bandwidth;
-        for i in 0..self.n {
-            let first = i.saturating_sub(b);
-            for j in first..=i {
-                let mut sum = self.get(i, j);
-                // Rows i and j (j <= i) both hold entries k >= i - b = first.
-                for k in first..j {
-                    sum -= self.get(i, k) * self.get(j, k);
+        let mut column = vec![0.0; b];
+        for k in 0..self.n {
+            let kk = self.at(k, k);
+            let pivot = self.band[kk];
+            // Written so that a NaN pivot fails too.
+            if pivot.is_nan() || pivot <= 0.0 {
+                return Err(NotPositiveDefinite { row: k, pivot });
+            }
+            let l_kk = pivot.sqrt();
+            self.band[kk] = l_kk;
+            let last = (k + b).min(self.n - 1);
+            for i in k + 1..=last {
+                let at = self.at(i, k);
+                self.band[at] /= l_kk;
+                column[i - k - 1] = self.band[at];
+            }
+            for i in k + 1..=last {
+                let l_ik = column[i - k - 1];
+                let row = self.at(i, k + 1)..=self.at(i, i);
+                for (a, &l_jk) in self.band[row].iter_mut().zip(&column[..i - k]) {
+                    *a -= l_ik * l_jk;
                 }
-                let entry = if j == i {
-                    // Written so that a NaN pivot fails too.
-                    if sum.is_nan() || sum <= 0.0 {
-                        return Err(NotPositiveDefinite { row: i, pivot: sum });
-                    }
-                    sum.sqrt()
-                } else {
-                    sum / self.get(j, j)
-                };
-                let at = self.at(i, j);
-                self.band[at] = entry;
             }
         }
         Ok(())
     }
 
-    /// Solves A x = rhs in place with the factor of `factor`.
+    /// Solves A x = rhs in place with the factor of `factor`. The forward substitution runs
+    /// by columns (each x_k subtracted from the rows below once known, in ascending k as the
+    /// row-wise sums take them), so that rows overlap instead of waiting on each other.
     pub fn solve(&self, rhs: &mut [f64]) {
         let b = self.bandwidth;
-        for i in 0..self.n {
-            let mut sum = rhs[i];
-            for k in i.saturating_sub(b)..i {
-                sum -= self.get(i, k) * rhs[k];
+        for k in 0..self.n {
+            let x_k = rhs[k] / self.get(k, k);
+            rhs[k] = x_k;
+            for i in k + 1..(k + b + 1).min(self.n) {
+                rhs[i] -= self.get(i, k) * x_k;
             }
-            rhs[i] = sum / self.get(i, i);
         }
         for i in (0..self.n).rev() {
             let mut sum = rhs[i];

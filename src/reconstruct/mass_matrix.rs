@@ -5,19 +5,29 @@
 use nalgebra::SVector;
 
 use super::banded::BandMatrix;
+use super::conjugate_gradients::{Breakdown, ConjugateGradients, MAX_ITERATIONS};
+use super::diagonals::SymmetricDiagonals;
 use super::GridState;
 use crate::integrate::{Divergence, FixedDof};
 
 /// Which mass matrix the nodal velocity and acceleration are solved with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MassMatrix {
-    /// M_ij = int rho N_i N_j over the transfer's quadrature, solved by a banded Cholesky
-    /// factorisation.
+    /// M_ij = int rho N_i N_j over the transfer's quadrature, solved by a band Cholesky
+    /// factorisation where the band is narrow (1D) and by conjugate gradients where it is a
+    /// grid row wide (2D).
     Consistent,
     /// Its row sums m_i = int rho N_i (partition of unity), as conservative as the consistent
     /// one.
     Lumped,
 }
+
+/// The band Cholesky factorisation is taken while bandwidth^2, its work per DOF, stays
+/// within this many times the stored entries per row, which with the iteration count set the
+/// work per DOF of the conjugate gradients. Measured on the 2D manufactured solution
+/// (docs/NOTES.md, the consistent-mass solve): the two break even near 16 cells for the hat
+/// and the dual-domain basis; every 1D basis has a band of at most 3 and is factorised.
+const DIRECT_SOLVE_RATIO: usize = 64;
 
 /// Assembles and solves M x = b per velocity component on the DOFs that carry mass and are
 /// free in that component; x is zero elsewhere.
@@ -25,12 +35,18 @@ pub struct MassSolver<const D: usize> {
     kind: MassMatrix,
     /// Per DOF and component: held at zero.
     fixed: Vec<[bool; D]>,
-    /// The consistent matrix in DOF numbering, and per component its factor restricted to
-    /// the DOFs listed in `free[k]`.
-    matrix: BandMatrix,
-    bandwidth: usize,
+    /// The consistent matrix in DOF numbering.
+    matrix: SymmetricDiagonals,
+    /// Whether this step's matrix is factorised (else solved by conjugate gradients).
+    direct: bool,
+    /// Direct: per component its factor restricted to the DOFs listed in `free[k]`.
     factors: Vec<BandMatrix>,
     free: Vec<Vec<u32>>,
+    /// The component whose factor each component solves with.
+    factor_of: [usize; D],
+    /// Iterative: per component 1 / m_i on its DOFs, zero elsewhere.
+    inverse_lumped: Vec<Vec<f64>>,
+    iterations: ConjugateGradients,
     rhs: Vec<f64>,
     /// sum_i p_i of the last `solve_momenta`: the momentum the DOFs received.
     received: SVector<f64, D>,
@@ -45,10 +61,13 @@ impl<const D: usize> MassSolver<D> {
         MassSolver {
             kind,
             fixed: mask,
-            matrix: BandMatrix::default(),
-            bandwidth: 0,
+            matrix: SymmetricDiagonals::default(),
+            direct: true,
             factors: vec![BandMatrix::default(); D],
             free: vec![Vec::new(); D],
+            factor_of: std::array::from_fn(|k| k),
+            inverse_lumped: vec![Vec::new(); D],
+            iterations: ConjugateGradients::default(),
             rhs: Vec::new(),
             received: SVector::zeros(),
         }
@@ -58,10 +77,15 @@ impl<const D: usize> MassSolver<D> {
         self.kind == MassMatrix::Consistent
     }
 
-    /// Starts a new consistent matrix with `bandwidth` sub-diagonals (the largest DOF
-    /// distance within one point's stencil).
+    /// Whether the last `prepare` factorised the matrix.
+    #[cfg(test)]
+    pub(crate) fn is_direct(&self) -> bool {
+        self.direct
+    }
+
+    /// Starts a new consistent matrix whose entries lie at most `bandwidth` off the diagonal
+    /// (the largest DOF distance within one point's stencil).
     pub fn reset(&mut self, bandwidth: usize) {
-        self.bandwidth = bandwidth;
         self.matrix.reset(self.fixed.len(), bandwidth);
     }
 
@@ -71,38 +95,74 @@ impl<const D: usize> MassSolver<D> {
         self.matrix.add(i, j, value);
     }
 
-    /// Factorises, per component, the consistent matrix restricted to the DOFs whose lumped
-    /// mass exceeds `empty_mass` and that are free in that component. A pivot that is not
-    /// positive stops the run with the DOF.
-    pub fn factor(&mut self, mass: &[f64], empty_mass: f64) -> Result<(), Divergence> {
+    /// Prepares the solves with the assembled matrix on, per component, the DOFs whose lumped
+    /// mass `mass` exceeds `empty_mass` and that are free in that component: the factors, or
+    /// the preconditioner of the conjugate gradients.
+    pub fn prepare(&mut self, mass: &[f64], empty_mass: f64) -> Result<(), Divergence> {
+        let bandwidth = self.matrix.bandwidth();
+        self.direct = bandwidth * bandwidth <= DIRECT_SOLVE_RATIO * self.matrix.entries_per_row();
+        if self.direct {
+            return self.factor(mass, empty_mass);
+        }
+        for (k, inverse) in self.inverse_lumped.iter_mut().enumerate() {
+            inverse.clear();
+            inverse.extend(mass.iter().zip(&self.fixed).map(|(&m, fixed)| {
+                if m > empty_mass && !fixed[k] {
+                    1.0 / m
+                } else {
+                    0.0
+                }
+            }));
+        }
+        Ok(())
+    }
+
+    /// Factorises, per component, the consistent matrix restricted to its DOFs; a component
+    /// with the same DOFs as an earlier one shares its factor. A pivot that is not positive
+    /// stops the run with the DOF.
+    fn factor(&mut self, mass: &[f64], empty_mass: f64) -> Result<(), Divergence> {
         for k in 0..D {
-            let free = &mut self.free[k];
+            let mut free = std::mem::take(&mut self.free[k]);
             free.clear();
             free.extend(
                 (0..mass.len())
                     .filter(|&i| mass[i] > empty_mass && !self.fixed[i][k])
                     .map(|i| i as u32),
             );
-            let factor = &mut self.factors[k];
-            factor.reset(free.len(), self.bandwidth);
-            for a in 0..free.len() {
-                let i = free[a] as usize;
-                for b in (0..=a).rev() {
-                    let j = free[b] as usize;
-                    if i - j > self.bandwidth {
-                        break;
-                    }
-                    factor.add(a, b, self.matrix.get(i, j));
+            let shared = (0..k).find(|&l| self.free[self.factor_of[l]] == free);
+            self.free[k] = free;
+            match shared {
+                Some(l) => self.factor_of[k] = self.factor_of[l],
+                None => {
+                    self.factor_of[k] = k;
+                    self.factor_component(k)?;
                 }
             }
-            factor.factor().map_err(|e| {
-                Divergence::Reconstruction(format!(
-                    "the consistent mass matrix is not positive definite at DOF {} (pivot {:e})",
-                    free[e.row], e.pivot
-                ))
-            })?;
         }
         Ok(())
+    }
+
+    fn factor_component(&mut self, k: usize) -> Result<(), Divergence> {
+        let free = &self.free[k];
+        let factor = &mut self.factors[k];
+        let bandwidth = self.matrix.bandwidth();
+        factor.reset(free.len(), bandwidth);
+        for a in 0..free.len() {
+            let i = free[a] as usize;
+            for b in (0..=a).rev() {
+                let j = free[b] as usize;
+                if i - j > bandwidth {
+                    break;
+                }
+                factor.add(a, b, self.matrix.get(i, j));
+            }
+        }
+        factor.factor().map_err(|e| {
+            Divergence::Reconstruction(format!(
+                "the consistent mass matrix is not positive definite at DOF {} (pivot {:e})",
+                free[e.row], e.pivot
+            ))
+        })
     }
 
     /// Solves M v = p in place for nodal momenta p, keeping sum_i p_i, the momentum the DOFs
@@ -112,9 +172,9 @@ impl<const D: usize> MassSolver<D> {
         mass: &[f64],
         empty_mass: f64,
         momenta: &mut [SVector<f64, D>],
-    ) {
+    ) -> Result<(), Divergence> {
         self.received = momenta.iter().sum();
-        self.solve(mass, empty_mass, momenta);
+        self.solve(mass, empty_mass, momenta)
     }
 
     /// sum_i p_i of the last `solve_momenta`.
@@ -122,47 +182,80 @@ impl<const D: usize> MassSolver<D> {
         self.received
     }
 
-    /// Solves M x = b in place for a nodal field; the consistent matrix must be factorised.
+    /// Solves M x = b in place for a nodal field; the consistent matrix must be prepared.
     /// `mass` is the lumped mass, which the lumped kind divides by.
-    pub fn solve(&mut self, mass: &[f64], empty_mass: f64, field: &mut [SVector<f64, D>]) {
-        match self.kind {
-            MassMatrix::Lumped => {
-                for (i, x) in field.iter_mut().enumerate() {
-                    let m = mass[i];
-                    for k in 0..D {
-                        x[k] = if m > empty_mass && !self.fixed[i][k] {
-                            x[k] / m
-                        } else {
-                            0.0
-                        };
-                    }
+    pub fn solve(
+        &mut self,
+        mass: &[f64],
+        empty_mass: f64,
+        field: &mut [SVector<f64, D>],
+    ) -> Result<(), Divergence> {
+        if self.kind == MassMatrix::Lumped {
+            for (i, x) in field.iter_mut().enumerate() {
+                let m = mass[i];
+                for k in 0..D {
+                    x[k] = if m > empty_mass && !self.fixed[i][k] {
+                        x[k] / m
+                    } else {
+                        0.0
+                    };
                 }
             }
-            MassMatrix::Consistent => {
-                let mut rhs = std::mem::take(&mut self.rhs);
-                for k in 0..D {
-                    let free = &self.free[k];
-                    rhs.clear();
-                    rhs.extend(free.iter().map(|&i| field[i as usize][k]));
-                    self.factors[k].solve(&mut rhs);
-                    for x in field.iter_mut() {
-                        x[k] = 0.0;
-                    }
-                    for (&i, &x) in free.iter().zip(&rhs) {
-                        field[i as usize][k] = x;
-                    }
+            return Ok(());
+        }
+        let mut rhs = std::mem::take(&mut self.rhs);
+        let mut solved = Ok(());
+        for k in 0..D {
+            rhs.clear();
+            if self.direct {
+                let free = &self.free[k];
+                rhs.extend(free.iter().map(|&i| field[i as usize][k]));
+                self.factors[self.factor_of[k]].solve(&mut rhs);
+                for x in field.iter_mut() {
+                    x[k] = 0.0;
                 }
-                self.rhs = rhs;
+                for (&i, &x) in free.iter().zip(&rhs) {
+                    field[i as usize][k] = x;
+                }
+                continue;
+            }
+            rhs.extend(field.iter().map(|x| x[k]));
+            solved = self
+                .iterations
+                .solve(&self.matrix, &self.inverse_lumped[k], &mut rhs)
+                .map(|_| ())
+                .map_err(breakdown_message);
+            if solved.is_err() {
+                break;
+            }
+            for (x, &value) in field.iter_mut().zip(&rhs) {
+                x[k] = value;
             }
         }
+        self.rhs = rhs;
+        solved
     }
 
     /// The grid solve with this matrix: a = M^-1 f, v_new = v + kick a, fixed components
     /// and empty DOFs held at zero. Afterwards `force` holds a.
-    pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) {
-        self.solve(&grid.mass, grid.empty_mass, &mut grid.force);
+    pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) -> Result<(), Divergence> {
+        self.solve(&grid.mass, grid.empty_mass, &mut grid.force)?;
         for i in 0..grid.mass.len() {
             grid.velocity_new[i] = grid.velocity[i] + grid.force[i] * kick;
         }
+        Ok(())
     }
+}
+
+fn breakdown_message(breakdown: Breakdown) -> Divergence {
+    Divergence::Reconstruction(match breakdown {
+        Breakdown::NotPositiveDefinite(curvature) => format!(
+            "the consistent mass matrix is not positive definite (conjugate gradients met \
+             p^T M p = {curvature:e})"
+        ),
+        Breakdown::NotConverged(residual) => format!(
+            "the consistent mass solve did not converge in {MAX_ITERATIONS} conjugate-gradient \
+             iterations (relative residual {residual:e})"
+        ),
+    })
 }

@@ -4,7 +4,9 @@
 
 mod banded;
 mod basis;
+mod conjugate_gradients;
 mod consistent_mass;
+mod diagonals;
 mod gauss;
 mod kernel;
 mod lattice;

@@ -192,10 +192,10 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         if consistent {
-            self.mass_solver.factor(&grid.mass, grid.empty_mass)?;
+            self.mass_solver.prepare(&grid.mass, grid.empty_mass)?;
         }
         self.mass_solver
-            .solve_momenta(&grid.mass, grid.empty_mass, &mut grid.velocity);
+            .solve_momenta(&grid.mass, grid.empty_mass, &mut grid.velocity)?;
         Ok(stats)
     }
 
@@ -207,7 +207,7 @@ impl<const D: usize> TaylorTransfer<D> {
         particles: &Particles<D>,
         grid: &GridState<D>,
         out: &mut [SVector<f64, D>],
-    ) {
+    ) -> Result<(), Divergence> {
         out.fill(SVector::zeros());
         for e in 0..self.elements() {
             if self.particles_of(e).is_none() {
@@ -226,12 +226,12 @@ impl<const D: usize> TaylorTransfer<D> {
             }
         }
         self.mass_solver
-            .solve_momenta(&grid.mass, grid.empty_mass, out);
+            .solve_momenta(&grid.mass, grid.empty_mass, out)
     }
 
     /// The grid solve with this transfer's mass matrix (`MassSolver::solve_grid`).
-    pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) {
-        self.mass_solver.solve_grid(grid, kick);
+    pub fn solve_grid(&mut self, grid: &mut GridState<D>, kick: f64) -> Result<(), Divergence> {
+        self.mass_solver.solve_grid(grid, kick)
     }
 
     /// Total of p_i (eq 9) at the last mapping or remap: the momentum the DOFs received,

@@ -284,7 +284,9 @@ impl<'a, const D: usize> Run<'a, D> {
                     Err(reason) => return (s, Err((s, reason))),
                 }
                 self.track_mapping(Mapping::Step);
-                self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick);
+                if let Err(reason) = self.transfer.solve_grid(&mut self.nodes, &self.fixed, kick) {
+                    return (s, Err((s, reason)));
+                }
             }
             self.record_probes(s, t, synchronising_half(s, dt));
             if s == 0 || s == steps || (every > 0 && s % every == 0) {
@@ -447,7 +449,7 @@ impl<'a, const D: usize> Run<'a, D> {
             &self.particles,
             &self.nodes,
             &mut self.remapped,
-        );
+        )?;
         self.track_mapping(Mapping::Remap);
         integrate::apply_fixed(&mut self.remapped, &self.fixed);
         integrate::deform_particles(
@@ -630,7 +632,9 @@ mod tests {
                 &mut run.nodes,
             )
             .unwrap();
-        run.transfer.solve_grid(&mut run.nodes, &run.fixed, dt);
+        run.transfer
+            .solve_grid(&mut run.nodes, &run.fixed, dt)
+            .unwrap();
     }
 
     /// The second step of `mpm` on Tran's bar with `integrator`, taken piece by piece: the

@@ -88,11 +88,19 @@ impl<const D: usize> Transfer<D> {
     }
 
     /// The grid solve (a = M^-1 f, v_new = v + kick a) with the transfer's mass matrix.
-    pub fn solve_grid(&mut self, grid: &mut GridState<D>, fixed: &[FixedDof], kick: f64) {
+    pub fn solve_grid(
+        &mut self,
+        grid: &mut GridState<D>,
+        fixed: &[FixedDof],
+        kick: f64,
+    ) -> Result<(), Divergence> {
         match self {
             Transfer::Taylor(tls) => tls.solve_grid(grid, kick),
             Transfer::ConsistentMass(cm) => cm.solve_grid(grid, kick),
-            _ => integrate::solve_grid(grid, fixed, kick),
+            _ => {
+                integrate::solve_grid(grid, fixed, kick);
+                Ok(())
+            }
         }
     }
 
@@ -116,15 +124,18 @@ impl<const D: usize> Transfer<D> {
         particles: &Particles<D>,
         grid: &GridState<D>,
         out: &mut [SVector<f64, D>],
-    ) {
+    ) -> Result<(), Divergence> {
         match self {
             Transfer::Shepard => {
                 remap_velocity(stencils, particles, &grid.mass, grid.empty_mass, out)
             }
             Transfer::Quadrature(q) => q.remap_velocity(stencils, particles, grid.empty_mass, out),
             Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
-            Transfer::ConsistentMass(cm) => cm.remap_velocity(stencils, particles, grid, out),
-            Transfer::Taylor(tls) => tls.remap_velocity(particles, grid, out),
+            Transfer::ConsistentMass(cm) => {
+                return cm.remap_velocity(stencils, particles, grid, out)
+            }
+            Transfer::Taylor(tls) => return tls.remap_velocity(particles, grid, out),
         }
+        Ok(())
     }
 }
