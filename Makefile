@@ -11,7 +11,8 @@
 #                   with a single-machine run
 #   make reproduce  every experiment from scratch into target/reproduce, compared byte for
 #                   byte with the committed results/ (part of make test)
-#   make bench      particle-steps per second per method and dimension
+#   make bench      per method: particle-steps per second, cost relative to mpm beside its
+#                   target, peak heap per particle
 #   make fuzz       mutation fuzzing of the experiment front end and of `run` on tiny
 #                   problems for FUZZ_SECONDS (default 300); findings in target/fuzz/findings/
 #   make deps       only install what is missing (libhdf5-dev, pkg-config, .venv)
