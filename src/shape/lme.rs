@@ -239,19 +239,26 @@ impl<const D: usize> LocalMaxEnt<D> {
         let radius_squared = self.radius * self.radius;
         let mut selected = 0;
         let mut unused = node.len();
-        for e in 0..node.len() {
-            let (index, local) = block_node(grid, &start, self.per_axis, e);
-            let on_grid = (0..D).all(|k| start[k] + local[k] <= grid.cells);
-            let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
-            if on_grid && d.norm_squared() <= radius_squared {
-                node[selected] = index as u32;
-                grad[selected] = d;
-                selected += 1;
-            } else {
-                unused -= 1;
-                node[unused] = index as u32;
-                weight[unused] = 0.0;
-                grad[unused] = SVector::zeros();
+        // Row by row along the first axis, so that only a row's first node needs `block_node`.
+        let stride = grid.stride(0);
+        for row in (0..node.len()).step_by(self.per_axis) {
+            let (first, mut local) = block_node(grid, &start, self.per_axis, row);
+            let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
+            let first = first - start[0].min(grid.cells) * stride;
+            for along in 0..self.per_axis {
+                local[0] = along;
+                let index = first + (start[0] + along).min(grid.cells) * stride;
+                let on_grid = row_on_grid && start[0] + along <= grid.cells;
+                let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
+                // Without branches, which the cut-off's circle makes unpredictable: a selected
+                // node's weight is the solver's to overwrite.
+                let keep = on_grid & (d.norm_squared() <= radius_squared);
+                let slot = if keep { selected } else { unused - 1 };
+                node[slot] = index as u32;
+                weight[slot] = 0.0;
+                grad[slot] = if keep { d } else { SVector::zeros() };
+                selected += usize::from(keep);
+                unused -= usize::from(!keep);
             }
         }
         let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
@@ -319,9 +326,10 @@ impl<const D: usize> LocalMaxEnt<D> {
         let mut alpha = 1.0;
         for _ in 0..=MAX_HALVINGS {
             let trial_mu = mu + step * alpha;
-            let trial = Moments::at(self.gamma, &trial_mu, offsets, weight);
-            if trial.log_z <= at.log_z + ARMIJO * alpha * slope + slack {
-                return Some((trial_mu, trial));
+            // The test needs log Z alone: r and J only for the trial taken.
+            let trial = Exponentials::at(self.gamma, &trial_mu, offsets, weight);
+            if trial.log_z() <= at.log_z + ARMIJO * alpha * slope + slack {
+                return Some((trial_mu, trial.moments(offsets, weight)));
             }
             alpha *= 0.5;
         }
@@ -344,20 +352,54 @@ impl<const D: usize> Moments<D> {
         offsets: &[SVector<f64, D>],
         weight: &mut [f64],
     ) -> Self {
-        // Subtracting the largest exponent keeps exp from overflowing and Z >= 1.
+        Exponentials::at(gamma, mu, offsets, weight).moments(offsets, weight)
+    }
+}
+
+/// Z at one multiplier mu, as exp(`largest`) `z` with the exponentials exp(f_a - largest) left
+/// in the weights.
+struct Exponentials {
+    largest: f64,
+    z: f64,
+}
+
+impl Exponentials {
+    fn at<const D: usize>(
+        gamma: f64,
+        mu: &SVector<f64, D>,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Self {
+        // Subtracting the largest exponent keeps exp from overflowing and Z >= 1. The exponents
+        // are finite, so a comparison does what f64::max does without its NaN handling.
         let mut largest = f64::NEG_INFINITY;
         for (p, d) in weight.iter_mut().zip(offsets) {
             *p = -gamma * d.norm_squared() + mu.dot(d);
-            largest = largest.max(*p);
+            if *p > largest {
+                largest = *p;
+            }
         }
         let mut z = 0.0;
         for p in weight.iter_mut() {
             *p = (*p - largest).exp();
             z += *p;
         }
+        Exponentials { largest, z }
+    }
+
+    fn log_z(&self) -> f64 {
+        self.largest + self.z.ln()
+    }
+
+    /// Normalises the exponentials in `weight` to p_a and takes r and J from them.
+    fn moments<const D: usize>(
+        &self,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Moments<D> {
         let mut r = SVector::zeros();
         for (p, d) in weight.iter_mut().zip(offsets) {
-            *p /= z;
+            *p /= self.z;
             r += d * *p;
         }
         // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation.
@@ -367,7 +409,7 @@ impl<const D: usize> Moments<D> {
             j += c * c.transpose() * *p;
         }
         Moments {
-            log_z: largest + z.ln(),
+            log_z: self.log_z(),
             r,
             j,
         }
