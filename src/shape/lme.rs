@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use nalgebra::{SMatrix, SVector};
 
 use super::block::{block_from, block_node};
-use super::{Dofs, Grid, Shape};
+use super::{Dofs, Grid, Shape, Stencils};
 
 /// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
 /// exp(-beta |x - x_a|^2) is below it are left out.
@@ -74,6 +74,27 @@ pub struct LocalMaxEnt<const D: usize> {
     max_step: f64,
     max_iterations: usize,
     failures: AtomicUsize,
+    /// Each particle's solution from the last `update_particles`, from which its next Newton
+    /// iteration starts; `None` (a cold start) before the first and after one that fell short.
+    warm: Vec<Option<Solution<D>>>,
+}
+
+/// A converged multiplier mu at the scaled position s = (x - x_0) / h, with J^-1 there.
+#[derive(Clone, Copy, Debug)]
+struct Solution<const D: usize> {
+    s: SVector<f64, D>,
+    mu: SVector<f64, D>,
+    inverse: SMatrix<f64, D, D>,
+}
+
+impl<const D: usize> Solution<D> {
+    /// The multiplier at `s` to first order. Moving x by delta h shifts every d_a by delta,
+    /// which turns the weights at mu into those at mu - 2 gamma delta about the old offsets
+    /// and adds delta to r: r = 0 again at mu + 2 gamma delta - J^-1 delta.
+    fn predict(&self, s: &SVector<f64, D>, gamma: f64) -> SVector<f64, D> {
+        let delta = s - self.s;
+        self.mu + delta * (2.0 * gamma) - self.inverse * delta
+    }
 }
 
 /// gamma and tolerance for which the LME problem has no solution at some point of the grid, or
@@ -199,6 +220,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             max_step: 2.0 * gamma * radius,
             max_iterations: MAX_ITERATIONS,
             failures: AtomicUsize::new(0),
+            warm: Vec::new(),
         })
     }
 
@@ -228,6 +250,64 @@ impl<const D: usize> LocalMaxEnt<D> {
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
     ) -> Result<usize, LmeFailure> {
+        self.fill(grid, x, &mut None, node, weight, grad)
+    }
+
+    /// Fills the stencils of the particles at `positions` as `Stencils::update` does with
+    /// `Shape::eval`, except that each particle's Newton iteration starts from its solution of
+    /// the last call, moved to its new position to first order (`Solution::predict`): a
+    /// particle moves little per step, so Newton needs a step or two instead of several from
+    /// zero. The result differs from a cold start's within the Newton tolerance. Returns the
+    /// first particle outside the grid.
+    pub fn update_particles(
+        &mut self,
+        stencils: &mut Stencils<D>,
+        grid: &Grid<D>,
+        positions: &[SVector<f64, D>],
+    ) -> Result<(), usize> {
+        let mut warm = std::mem::take(&mut self.warm);
+        warm.resize(positions.len(), None);
+        let k = stencils.per_point;
+        let chunks = stencils
+            .node
+            .chunks_exact_mut(k)
+            .zip(stencils.weight.chunks_exact_mut(k))
+            .zip(stencils.grad.chunks_exact_mut(k))
+            .zip(positions.iter().zip(warm.iter_mut()));
+        let mut outcome = Ok(());
+        for (p, (((node, weight), grad), (x, solution))) in chunks.enumerate() {
+            if !self.count(self.fill(grid, x, solution, node, weight, grad)) {
+                outcome = Err(p);
+                break;
+            }
+        }
+        self.warm = warm;
+        outcome
+    }
+
+    /// Whether the point was on the grid; counts the evaluations that stopped short.
+    fn count(&self, status: Result<usize, LmeFailure>) -> bool {
+        match status {
+            Ok(_) => true,
+            Err(LmeFailure::Outside) => false,
+            Err(_) => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                true
+            }
+        }
+    }
+
+    /// `evaluate` with Newton starting from the prediction of `warm`, or from zero without
+    /// one; `warm` is left at this solution, or at `None` when Newton stopped short.
+    fn fill(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        warm: &mut Option<Solution<D>>,
+        node: &mut [u32],
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+    ) -> Result<usize, LmeFailure> {
         debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         if grid.locate(x).is_none() {
             return Err(LmeFailure::Outside);
@@ -239,27 +319,45 @@ impl<const D: usize> LocalMaxEnt<D> {
         let radius_squared = self.radius * self.radius;
         let mut selected = 0;
         let mut unused = node.len();
-        for e in 0..node.len() {
-            let (index, local) = block_node(grid, &start, self.per_axis, e);
-            let on_grid = (0..D).all(|k| start[k] + local[k] <= grid.cells);
-            let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
-            if on_grid && d.norm_squared() <= radius_squared {
-                node[selected] = index as u32;
-                grad[selected] = d;
-                selected += 1;
-            } else {
-                unused -= 1;
-                node[unused] = index as u32;
-                weight[unused] = 0.0;
-                grad[unused] = SVector::zeros();
+        // Row by row along the first axis, so that only a row's first node needs `block_node`.
+        let stride = grid.stride(0);
+        for row in (0..node.len()).step_by(self.per_axis) {
+            let (first, mut local) = block_node(grid, &start, self.per_axis, row);
+            let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
+            let first = first - start[0].min(grid.cells) * stride;
+            for along in 0..self.per_axis {
+                local[0] = along;
+                let index = first + (start[0] + along).min(grid.cells) * stride;
+                let on_grid = row_on_grid && start[0] + along <= grid.cells;
+                let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
+                // Without branches, which the cut-off's circle makes unpredictable: a selected
+                // node's weight is the solver's to overwrite.
+                let keep = on_grid & (d.norm_squared() <= radius_squared);
+                let slot = if keep { selected } else { unused - 1 };
+                node[slot] = index as u32;
+                weight[slot] = 0.0;
+                grad[slot] = if keep { d } else { SVector::zeros() };
+                selected += usize::from(keep);
+                unused -= usize::from(!keep);
             }
         }
         let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
-        let (at, status) = self.solve(offsets, weights);
+        let cold = SVector::zeros();
+        let start_mu = warm.map_or(cold, |solution| solution.predict(&s, self.gamma));
+        let mut solved = self.solve(start_mu, offsets, weights);
+        if solved.2.is_err() && warm.is_some() {
+            // A warm start that falls short (from a multiplier grown large on a face, say)
+            // is not yet a failure: the cold start may still converge.
+            solved = self.solve(cold, offsets, weights);
+        }
+        let (mu, at, status) = solved;
         // Eq 36 with the offsets taken about their mean r: at r = 0 it is eq 36, and at any
         // iterate it is the exact gradient of weights whose first moment misses x by the fixed
         // r, so sum_a grad p_a = 0 and sum_a x_a (x) grad p_a = I hold to round-off.
         let inverse = at.j.cholesky().map(|c| c.inverse());
+        *warm = inverse
+            .filter(|_| status.is_ok())
+            .map(|inverse| Solution { s, mu, inverse });
         for (g, p) in offsets.iter_mut().zip(weights.iter()) {
             *g = match &inverse {
                 Some(inverse) => -(inverse * (*g - at.r)) * (p * grid.inv_h()),
@@ -269,26 +367,27 @@ impl<const D: usize> LocalMaxEnt<D> {
         status
     }
 
-    /// Newton's method on log Z from mu = 0, leaving the weights of the last iterate in
-    /// `weight`: its moments, and the number of steps or why Newton stopped short.
+    /// Newton's method on log Z from `mu`, leaving the weights of the last iterate in
+    /// `weight`: that iterate, its moments, and the number of steps or why Newton stopped
+    /// short.
     fn solve(
         &self,
+        mut mu: SVector<f64, D>,
         offsets: &[SVector<f64, D>],
         weight: &mut [f64],
-    ) -> (Moments<D>, Result<usize, LmeFailure>) {
-        let mut mu = SVector::zeros();
+    ) -> (SVector<f64, D>, Moments<D>, Result<usize, LmeFailure>) {
         let mut at = Moments::at(self.gamma, &mu, offsets, weight);
         let mut steps = 0;
         loop {
             let residual = at.r.norm();
             if residual < RESIDUAL_TOLERANCE {
-                return (at, Ok(steps));
+                return (mu, at, Ok(steps));
             }
             if steps == self.max_iterations {
-                return (at, Err(LmeFailure::NotConverged { residual }));
+                return (mu, at, Err(LmeFailure::NotConverged { residual }));
             }
             let Some(cholesky) = at.j.cholesky() else {
-                return (at, Err(LmeFailure::Stalled { residual }));
+                return (mu, at, Err(LmeFailure::Stalled { residual }));
             };
             let mut step = -cholesky.solve(&at.r);
             step *= (self.max_step / step.norm()).min(1.0);
@@ -297,7 +396,7 @@ impl<const D: usize> LocalMaxEnt<D> {
                 None => {
                     // The rejected trials overwrote the weights.
                     let at = Moments::at(self.gamma, &mu, offsets, weight);
-                    return (at, Err(LmeFailure::Stalled { residual }));
+                    return (mu, at, Err(LmeFailure::Stalled { residual }));
                 }
             }
             steps += 1;
@@ -319,9 +418,10 @@ impl<const D: usize> LocalMaxEnt<D> {
         let mut alpha = 1.0;
         for _ in 0..=MAX_HALVINGS {
             let trial_mu = mu + step * alpha;
-            let trial = Moments::at(self.gamma, &trial_mu, offsets, weight);
-            if trial.log_z <= at.log_z + ARMIJO * alpha * slope + slack {
-                return Some((trial_mu, trial));
+            // The test needs log Z alone: r and J only for the trial taken.
+            let trial = Exponentials::at(self.gamma, &trial_mu, offsets, weight);
+            if trial.log_z() <= at.log_z + ARMIJO * alpha * slope + slack {
+                return Some((trial_mu, trial.moments(offsets, weight)));
             }
             alpha *= 0.5;
         }
@@ -344,20 +444,54 @@ impl<const D: usize> Moments<D> {
         offsets: &[SVector<f64, D>],
         weight: &mut [f64],
     ) -> Self {
-        // Subtracting the largest exponent keeps exp from overflowing and Z >= 1.
+        Exponentials::at(gamma, mu, offsets, weight).moments(offsets, weight)
+    }
+}
+
+/// Z at one multiplier mu, as exp(`largest`) `z` with the exponentials exp(f_a - largest) left
+/// in the weights.
+struct Exponentials {
+    largest: f64,
+    z: f64,
+}
+
+impl Exponentials {
+    fn at<const D: usize>(
+        gamma: f64,
+        mu: &SVector<f64, D>,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Self {
+        // Subtracting the largest exponent keeps exp from overflowing and Z >= 1. The exponents
+        // are finite, so a comparison does what f64::max does without its NaN handling.
         let mut largest = f64::NEG_INFINITY;
         for (p, d) in weight.iter_mut().zip(offsets) {
             *p = -gamma * d.norm_squared() + mu.dot(d);
-            largest = largest.max(*p);
+            if *p > largest {
+                largest = *p;
+            }
         }
         let mut z = 0.0;
         for p in weight.iter_mut() {
             *p = (*p - largest).exp();
             z += *p;
         }
+        Exponentials { largest, z }
+    }
+
+    fn log_z(&self) -> f64 {
+        self.largest + self.z.ln()
+    }
+
+    /// Normalises the exponentials in `weight` to p_a and takes r and J from them.
+    fn moments<const D: usize>(
+        &self,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> Moments<D> {
         let mut r = SVector::zeros();
         for (p, d) in weight.iter_mut().zip(offsets) {
-            *p /= z;
+            *p /= self.z;
             r += d * *p;
         }
         // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation.
@@ -367,7 +501,7 @@ impl<const D: usize> Moments<D> {
             j += c * c.transpose() * *p;
         }
         Moments {
-            log_z: largest + z.ln(),
+            log_z: self.log_z(),
             r,
             j,
         }
@@ -387,14 +521,7 @@ impl<const D: usize> Shape<D> for LocalMaxEnt<D> {
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
     ) -> bool {
-        match self.evaluate(grid, x, node, weight, grad) {
-            Ok(_) => true,
-            Err(LmeFailure::Outside) => false,
-            Err(_) => {
-                self.failures.fetch_add(1, Ordering::Relaxed);
-                true
-            }
-        }
+        self.count(self.evaluate(grid, x, node, weight, grad))
     }
 }
 

@@ -405,9 +405,8 @@ impl<'a, const D: usize> Run<'a, D> {
                 self.transfer.refresh_basis(dual);
                 Ok(())
             }
-            Basis::LocalMaxEnt(lme) => self
-                .stencils
-                .update(lme, &self.grid, &self.particles.x)
+            Basis::LocalMaxEnt(lme) => lme
+                .update_particles(&mut self.stencils, &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
         }
     }

@@ -4,7 +4,7 @@ use super::*;
 use crate::benchmarks::Domain;
 use crate::rng::Lcg;
 use crate::shape::stencils::assert_gradient_matches_differences;
-use crate::shape::{lattice_coords, LinearHat};
+use crate::shape::{lattice_coords, LinearHat, Stencils};
 
 /// The two values of gamma Molinos et al. run.
 const PAPER_GAMMAS: [f64; 2] = [0.8, 3.0];
@@ -325,4 +325,62 @@ fn stencils_are_bounded() {
     // A tiny tolerance widens the stencil as a tiny gamma does.
     assert!(LocalMaxEnt::<1>::with_tolerance(1.0, 1e-300).is_ok());
     assert!(LocalMaxEnt::<2>::with_tolerance(1.0, 1e-300).is_err());
+}
+
+/// Stencils of `lme` evaluated cold, through `Shape::eval`.
+fn cold_stencils<const D: usize>(
+    lme: &LocalMaxEnt<D>,
+    g: &Grid<D>,
+    xs: &[SVector<f64, D>],
+) -> Stencils<D> {
+    let mut stencils = Stencils::new(lme.nodes_per_point(), xs.len());
+    stencils.update(lme, g, xs).unwrap();
+    stencils
+}
+
+/// `update_particles` starts cold, bit for bit `eval`'s stencils; after the particles move
+/// (off the faces too, where the last multiplier was huge) its warm starts agree with cold
+/// evaluations to the Newton tolerance, and still reproduce x to it.
+fn check_warm_start<const D: usize>(gamma: f64) {
+    let g = grid::<D>(6);
+    let cold_lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    let mut lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    let mut xs = points(&g, 0x9e3779b97f4a7c15);
+    let mut warm = Stencils::new(lme.nodes_per_point(), xs.len());
+    lme.update_particles(&mut warm, &g, &xs).unwrap();
+    let cold = cold_stencils(&cold_lme, &g, &xs);
+    assert_eq!(
+        (&warm.node, &warm.weight, &warm.grad),
+        (&cold.node, &cold.weight, &cold.grad)
+    );
+    let centre = g.lower + SVector::repeat(0.5 * g.cells as f64 * g.h);
+    for pass in 1..=3 {
+        let shrink = 1.0 - 1e-4 * f64::from(pass);
+        for x in &mut xs {
+            *x = centre + (*x - centre) * shrink;
+        }
+        lme.update_particles(&mut warm, &g, &xs).unwrap();
+        let cold = cold_stencils(&cold_lme, &g, &xs);
+        assert_eq!(warm.node, cold.node);
+        for (p, x) in xs.iter().enumerate() {
+            let moment: SVector<f64, D> = warm.of(p).map(|(i, w, _)| g.node_position(i) * w).sum();
+            assert!(
+                (moment - x).norm() < 1.1 * RESIDUAL_TOLERANCE * g.h,
+                "{x:?}"
+            );
+            for ((_, w, gr), (_, wc, grc)) in warm.of(p).zip(cold.of(p)) {
+                assert!((w - wc).abs() < 1e-11, "{x:?}: {w} vs {wc}");
+                assert!((gr - grc).norm() < 1e-9 / g.h, "{x:?}: {gr:?} vs {grc:?}");
+            }
+        }
+    }
+    assert_eq!(lme.failures(), 0);
+}
+
+#[test]
+fn lme_warm_start_agrees_with_cold_start() {
+    for gamma in PAPER_GAMMAS {
+        check_warm_start::<1>(gamma);
+        check_warm_start::<2>(gamma);
+    }
 }
