@@ -12,7 +12,7 @@ use num_traits::Zero;
 use super::basis::{monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
-use super::solve::{add_weighted_outer, mls_coefficients, Moments, OrthogonalBasis};
+use super::solve::{add_weighted_outer, mls_coefficients, OrthogonalBasis};
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,8 +97,9 @@ pub struct Reconstructor<const D: usize> {
     lattice: Lattice<D>,
     terms: usize,
     radius: f64,
-    /// Entries per particle: the reachable lattice points, padded with zero weights.
-    stride: usize,
+    /// Particle p's entries are `start[p]..start[p + 1]`: the lattice points it reaches,
+    /// with the first axis fastest.
+    start: Vec<usize>,
     point: Vec<u32>,
     /// (x_p - x_e)/h of each entry.
     offset: Vec<SVector<f64, D>>,
@@ -124,7 +125,7 @@ impl<const D: usize> Reconstructor<D> {
             recipe,
             terms,
             radius,
-            stride: per_axis.pow(D as u32),
+            start: Vec::new(),
             point: Vec::new(),
             offset: Vec::new(),
             phi: Vec::new(),
@@ -151,20 +152,35 @@ impl<const D: usize> Reconstructor<D> {
     /// Builds the shape functions for particles at `x`. Points no particle reaches get
     /// zero shape functions and are not counted.
     pub fn fit(&mut self, x: &[SVector<f64, D>]) -> Result<FitStats, SingularMoments> {
-        self.gather_weights(x);
-        let stats = self.solve()?;
-        self.finish_shape_functions();
+        // The basis size as a constant lets the per-entry loops over terms unroll.
+        match self.terms {
+            1 => self.fit_with::<1>(x),
+            2 => self.fit_with::<2>(x),
+            3 => self.fit_with::<3>(x),
+            MAX_TERMS => self.fit_with::<MAX_TERMS>(x),
+            t => unreachable!("no basis has {t} terms"),
+        }
+    }
+
+    fn fit_with<const T: usize>(
+        &mut self,
+        x: &[SVector<f64, D>],
+    ) -> Result<FitStats, SingularMoments> {
+        self.gather_weights::<T>(x);
+        let stats = self.solve::<T>()?;
+        self.finish_shape_functions::<T>();
         Ok(stats)
     }
 
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
     /// the moment matrices, summed particle by particle in order.
-    fn gather_weights(&mut self, x: &[SVector<f64, D>]) {
-        let n = x.len() * self.stride;
-        self.point.resize(n, 0);
-        self.offset.resize(n, SVector::zeros());
-        self.phi.resize(n, 0.0);
+    fn gather_weights<const T: usize>(&mut self, x: &[SVector<f64, D>]) {
+        self.start.clear();
+        self.point.clear();
+        self.offset.clear();
+        self.phi.clear();
         self.moments.fill(0.0);
+        self.start.push(0);
         let mut near = [[(0usize, 0.0f64); MAX_PER_AXIS]; D];
         // The weight is a tensor product: its 1D factors are computed once per axis.
         let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
@@ -172,8 +188,7 @@ impl<const D: usize> Reconstructor<D> {
         let inv_scale = 1.0 / self.recipe.kernel.scale;
         let weight = self.recipe.kernel.weight;
         let mut q = [0.0; MAX_TERMS];
-        let t = self.terms;
-        for (p, xp) in x.iter().enumerate() {
+        for xp in x {
             for k in 0..D {
                 count[k] = self
                     .lattice
@@ -182,84 +197,77 @@ impl<const D: usize> Reconstructor<D> {
                     axis_weight[k][j] = weight.eval(near[k][j].1.abs() * inv_scale);
                 }
             }
-            let base = p * self.stride;
             let total: usize = count.iter().product();
-            for slot in 0..self.stride {
-                let entry = base + slot;
-                if slot >= total {
-                    self.point[entry] = 0;
-                    self.phi[entry] = 0.0;
-                    continue;
-                }
-                let mut rest = slot;
+            // An odometer over the per-axis neighbours, the first axis fastest.
+            let mut j = [0usize; D];
+            for _ in 0..total {
                 let mut e = 0;
                 let mut w = 1.0;
                 let mut d = SVector::<f64, D>::zeros();
                 for k in 0..D {
-                    let j = rest % count[k];
-                    rest /= count[k];
-                    let (i, dk) = near[k][j];
+                    let (i, dk) = near[k][j[k]];
                     e += i * self.lattice.stride(k);
                     d[k] = -dk;
-                    w *= axis_weight[k][j];
+                    w *= axis_weight[k][j[k]];
                 }
-                self.point[entry] = e as u32;
-                self.offset[entry] = d;
-                self.phi[entry] = w;
+                for k in 0..D {
+                    j[k] += 1;
+                    if j[k] < count[k] {
+                        break;
+                    }
+                    j[k] = 0;
+                }
+                self.point.push(e as u32);
+                self.offset.push(d);
+                self.phi.push(w);
                 monomials(self.recipe.degree, &d, &mut q);
-                add_weighted_outer(&mut self.moments[e * t * t..(e + 1) * t * t], t, w, &q[..t]);
+                add_weighted_outer(&mut self.moments[e * T * T..][..T * T], T, w, &q[..T]);
             }
+            self.start.push(self.point.len());
         }
     }
 
     /// The coefficients c_e at every evaluation point.
-    fn solve(&mut self) -> Result<FitStats, SingularMoments> {
-        let t = self.terms;
+    fn solve<const T: usize>(&mut self) -> Result<FitStats, SingularMoments> {
         let mut stats = FitStats::default();
         for e in 0..self.lattice.len() {
-            let a = &self.moments[e * t * t..(e + 1) * t * t];
-            let c = &mut self.coeffs[e * t..(e + 1) * t];
+            let a = &self.moments[e * T * T..][..T * T];
+            let c = &mut self.coeffs[e * T..][..T];
             self.covered[e] = a[0] > 0.0;
             if !self.covered[e] {
                 c.fill(0.0);
                 continue;
             }
-            let mut full: Moments = [0.0; MAX_TERMS * MAX_TERMS];
-            for r in 0..t {
-                full[r * MAX_TERMS..r * MAX_TERMS + t].copy_from_slice(&a[r * t..(r + 1) * t]);
-            }
             stats.fits += 1;
             let solved = match self.recipe.solver {
-                Solver::Mls => mls_coefficients(&full, t).ok_or_else(|| SingularMoments {
+                Solver::Mls => mls_coefficients(a, T, T).ok_or_else(|| SingularMoments {
                     point: e,
                     position: self.lattice.point(e).iter().copied().collect(),
                 })?,
                 Solver::Imls => {
-                    let basis = OrthogonalBasis::from_moments(&full, t);
-                    if basis.rank() < t {
+                    let basis = OrthogonalBasis::from_rows(a, T, T);
+                    if basis.rank() < T {
                         stats.rank_deficient += 1;
                     }
                     basis.shape_coefficients()
                 }
             };
-            c.copy_from_slice(&solved[..t]);
+            c.copy_from_slice(&solved[..T]);
         }
         Ok(stats)
     }
 
     /// Pass two: phi_p(x_e) = w q((x_p - x_e)/h) . c_e for every entry.
-    fn finish_shape_functions(&mut self) {
-        let t = self.terms;
+    fn finish_shape_functions<const T: usize>(&mut self) {
         let mut q = [0.0; MAX_TERMS];
-        for entry in 0..self.phi.len() {
-            let w = self.phi[entry];
+        for ((phi, &e), d) in self.phi.iter_mut().zip(&self.point).zip(&self.offset) {
+            let w = *phi;
             if w == 0.0 {
                 continue;
             }
-            let e = self.point[entry] as usize;
-            monomials(self.recipe.degree, &self.offset[entry], &mut q);
-            let c = &self.coeffs[e * t..(e + 1) * t];
-            self.phi[entry] = w * (0..t).map(|j| q[j] * c[j]).sum::<f64>();
+            monomials(self.recipe.degree, d, &mut q);
+            let c = &self.coeffs[e as usize * T..][..T];
+            *phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
         }
     }
 
@@ -270,11 +278,10 @@ impl<const D: usize> Reconstructor<D> {
     {
         out.fill(T::zero());
         for (p, &value) in values.iter().enumerate() {
-            let base = p * self.stride;
-            for entry in base..base + self.stride {
-                let phi = self.phi[entry];
+            let entries = self.start[p]..self.start[p + 1];
+            for (&e, &phi) in self.point[entries.clone()].iter().zip(&self.phi[entries]) {
                 if phi != 0.0 {
-                    out[self.point[entry] as usize] += value * phi;
+                    out[e as usize] += value * phi;
                 }
             }
         }
