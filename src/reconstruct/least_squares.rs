@@ -9,7 +9,7 @@ use std::ops::{AddAssign, Mul};
 use nalgebra::SVector;
 use num_traits::Zero;
 
-use super::basis::{monomials, Degree, MAX_TERMS};
+use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
 use super::solve::{add_weighted_outer, mls_coefficients, OrthogonalBasis};
@@ -97,6 +97,8 @@ pub struct Reconstructor<const D: usize> {
     lattice: Lattice<D>,
     terms: usize,
     radius: f64,
+    /// The most lattice points one particle reaches.
+    max_entries: usize,
     /// Particle p's entries are `start[p]..start[p + 1]`: the lattice points it reaches,
     /// with the first axis fastest.
     start: Vec<usize>,
@@ -125,6 +127,7 @@ impl<const D: usize> Reconstructor<D> {
             recipe,
             terms,
             radius,
+            max_entries: per_axis.pow(D as u32),
             start: Vec::new(),
             point: Vec::new(),
             offset: Vec::new(),
@@ -166,6 +169,7 @@ impl<const D: usize> Reconstructor<D> {
         &mut self,
         x: &[SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
+        debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
         self.gather_weights::<T>(x);
         let stats = self.solve::<T>()?;
         self.finish_shape_functions::<T>();
@@ -175,26 +179,35 @@ impl<const D: usize> Reconstructor<D> {
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
     /// the moment matrices, summed particle by particle in order.
     fn gather_weights<const T: usize>(&mut self, x: &[SVector<f64, D>]) {
-        self.start.clear();
-        self.point.clear();
-        self.offset.clear();
-        self.phi.clear();
+        // Sized for the most entries once; indexed writes are cheaper than pushes.
+        let capacity = x.len() * self.max_entries;
+        self.point.resize(capacity, 0);
+        self.offset.resize(capacity, SVector::zeros());
+        self.phi.resize(capacity, 0.0);
+        self.start.resize(x.len() + 1, 0);
         self.moments.fill(0.0);
-        self.start.push(0);
-        let mut near = [[(0usize, 0.0f64); MAX_PER_AXIS]; D];
-        // The weight is a tensor product: its 1D factors are computed once per axis.
+        // Borrowed apart so the loop keeps them in registers.
+        let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
+        let (point, offset, phi) = (&mut self.point[..], &mut self.offset[..], &mut self.phi[..]);
+        let (start, moments) = (&mut self.start[..], &mut self.moments[..]);
+        let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
+        // Per axis and neighbour: the part of the lattice index, the offset and the 1D
+        // weight factor, so each entry only combines them.
+        let mut index = [[0usize; MAX_PER_AXIS]; D];
+        let mut axis_offset = [[0.0f64; MAX_PER_AXIS]; D];
         let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
         let mut count = [0usize; D];
         let inv_scale = 1.0 / self.recipe.kernel.scale;
         let weight = self.recipe.kernel.weight;
         let mut q = [0.0; MAX_TERMS];
-        for xp in x {
+        let mut entry = 0;
+        for (p, xp) in x.iter().enumerate() {
             for k in 0..D {
-                count[k] = self
-                    .lattice
-                    .near_on_axis(k, xp[k], self.radius, &mut near[k]);
-                for j in 0..count[k] {
-                    axis_weight[k][j] = weight.eval(near[k][j].1.abs() * inv_scale);
+                count[k] = lattice.near_on_axis(k, xp[k], radius, &mut near);
+                for (j, &(i, dk)) in near[..count[k]].iter().enumerate() {
+                    index[k][j] = i * lattice.stride(k);
+                    axis_offset[k][j] = -dk;
+                    axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
                 }
             }
             let total: usize = count.iter().product();
@@ -205,9 +218,8 @@ impl<const D: usize> Reconstructor<D> {
                 let mut w = 1.0;
                 let mut d = SVector::<f64, D>::zeros();
                 for k in 0..D {
-                    let (i, dk) = near[k][j[k]];
-                    e += i * self.lattice.stride(k);
-                    d[k] = -dk;
+                    e += index[k][j[k]];
+                    d[k] = axis_offset[k][j[k]];
                     w *= axis_weight[k][j[k]];
                 }
                 for k in 0..D {
@@ -217,13 +229,14 @@ impl<const D: usize> Reconstructor<D> {
                     }
                     j[k] = 0;
                 }
-                self.point.push(e as u32);
-                self.offset.push(d);
-                self.phi.push(w);
-                monomials(self.recipe.degree, &d, &mut q);
-                add_weighted_outer(&mut self.moments[e * T * T..][..T * T], T, w, &q[..T]);
+                point[entry] = e as u32;
+                offset[entry] = d;
+                phi[entry] = w;
+                entry += 1;
+                monomials(degree, &d, &mut q);
+                add_weighted_outer(&mut moments[e * T * T..][..T * T], T, w, &q[..T]);
             }
-            self.start.push(self.point.len());
+            start[p + 1] = entry;
         }
     }
 
@@ -260,13 +273,17 @@ impl<const D: usize> Reconstructor<D> {
     /// Pass two: phi_p(x_e) = w q((x_p - x_e)/h) . c_e for every entry.
     fn finish_shape_functions<const T: usize>(&mut self) {
         let mut q = [0.0; MAX_TERMS];
-        for ((phi, &e), d) in self.phi.iter_mut().zip(&self.point).zip(&self.offset) {
+        let degree = degree_of::<T, D>();
+        let entries = self.start.last().copied().unwrap_or(0);
+        let phis = &mut self.phi[..entries];
+        let coeffs = &self.coeffs[..];
+        for ((phi, &e), d) in phis.iter_mut().zip(&self.point).zip(&self.offset) {
             let w = *phi;
             if w == 0.0 {
                 continue;
             }
-            monomials(self.recipe.degree, d, &mut q);
-            let c = &self.coeffs[e as usize * T..][..T];
+            monomials(degree, d, &mut q);
+            let c = &coeffs[e as usize * T..][..T];
             *phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
         }
     }
@@ -277,9 +294,14 @@ impl<const D: usize> Reconstructor<D> {
         T: Copy + Zero + AddAssign + Mul<f64, Output = T>,
     {
         out.fill(T::zero());
-        for (p, &value) in values.iter().enumerate() {
-            let entries = self.start[p]..self.start[p + 1];
-            for (&e, &phi) in self.point[entries.clone()].iter().zip(&self.phi[entries]) {
+        assert!(
+            values.len() < self.start.len(),
+            "more values than fitted particles"
+        );
+        let (point, phi) = (&self.point[..], &self.phi[..]);
+        for (&value, ends) in values.iter().zip(self.start.windows(2)) {
+            let entries = ends[0]..ends[1];
+            for (&e, &phi) in point[entries.clone()].iter().zip(&phi[entries]) {
                 if phi != 0.0 {
                     out[e as usize] += value * phi;
                 }

@@ -109,6 +109,7 @@ impl OrthogonalBasis {
 
     /// c of phi_p = w_p q_p . c: u^h = sum_i p_i(x) <p_i, u>/<p_i, p_i> (eq 11, 13) with
     /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point.
+    #[inline]
     pub fn shape_coefficients(&self) -> [f64; MAX_TERMS] {
         let mut first = [0.0; MAX_TERMS];
         first[0] = 1.0;
@@ -118,6 +119,7 @@ impl OrthogonalBasis {
     /// The least-squares coefficients c of sum_j c_j q_j from rhs_j = <q_j, u>:
     /// c = sum_i p_i <p_i, u>/<p_i, p_i> over the kept polynomials (the pseudo-inverse of the
     /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j.
+    #[inline]
     pub fn solve(&self, rhs: &[f64; MAX_TERMS]) -> [f64; MAX_TERMS] {
         let mut out = [0.0; MAX_TERMS];
         for i in 0..self.terms {
