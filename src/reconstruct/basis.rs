@@ -36,6 +36,17 @@ impl Degree {
     }
 }
 
+/// The degree whose basis has `T` terms in `D` dimensions (1D and 2D): a constant where
+/// both are.
+#[inline(always)]
+pub(super) fn degree_of<const T: usize, const D: usize>() -> Degree {
+    match T {
+        1 => Degree::CONSTANT,
+        _ if T == 1 + D => Degree::LINEAR,
+        _ => Degree::QUADRATIC,
+    }
+}
+
 /// Fills `q` with the monomials of `d` (ordered by degree, then x before y) and returns
 /// how many there are.
 #[inline]

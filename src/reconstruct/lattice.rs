@@ -85,14 +85,23 @@ impl<const D: usize> Lattice<D> {
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
-        let first_cell = (s - radius - 1.0).floor().max(0.0) as usize;
-        let last_cell = (s + radius).floor().max(0.0) as usize;
+        // `as` truncates and saturates below zero, which is floor().max(0.0) here without
+        // a libm call.
+        let first_cell = (s - radius - 1.0) as usize;
+        let last_cell = (s + radius) as usize;
         let mut n = 0;
-        for i in first_cell * k..((last_cell + 1) * k).min(self.per_axis) {
-            let d = ((i / k) as f64 + self.offsets[i % k]) - s;
-            if d.abs() < radius {
-                out[n] = (i, d);
-                n += 1;
+        // Cells, then offsets within a cell: lattice index order without a division.
+        'cells: for cell in first_cell..=last_cell {
+            for (j, &offset) in self.offsets.iter().enumerate() {
+                let i = cell * k + j;
+                if i >= self.per_axis {
+                    break 'cells;
+                }
+                let d = (cell as f64 + offset) - s;
+                if d.abs() < radius {
+                    out[n] = (i, d);
+                    n += 1;
+                }
             }
         }
         n

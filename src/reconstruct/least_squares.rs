@@ -9,10 +9,10 @@ use std::ops::{AddAssign, Mul};
 use nalgebra::SVector;
 use num_traits::Zero;
 
-use super::basis::{monomials, Degree, MAX_TERMS};
+use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
-use super::solve::{add_weighted_outer, mls_coefficients, Moments, OrthogonalBasis};
+use super::solve::{add_weighted_outer, mls_coefficients, OrthogonalBasis};
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,8 +97,11 @@ pub struct Reconstructor<const D: usize> {
     lattice: Lattice<D>,
     terms: usize,
     radius: f64,
-    /// Entries per particle: the reachable lattice points, padded with zero weights.
-    stride: usize,
+    /// The most lattice points one particle reaches.
+    max_entries: usize,
+    /// Particle p's entries are `start[p]..start[p + 1]`: the lattice points it reaches,
+    /// with the first axis fastest.
+    start: Vec<usize>,
     point: Vec<u32>,
     /// (x_p - x_e)/h of each entry.
     offset: Vec<SVector<f64, D>>,
@@ -124,7 +127,8 @@ impl<const D: usize> Reconstructor<D> {
             recipe,
             terms,
             radius,
-            stride: per_axis.pow(D as u32),
+            max_entries: per_axis.pow(D as u32),
+            start: Vec::new(),
             point: Vec::new(),
             offset: Vec::new(),
             phi: Vec::new(),
@@ -151,115 +155,136 @@ impl<const D: usize> Reconstructor<D> {
     /// Builds the shape functions for particles at `x`. Points no particle reaches get
     /// zero shape functions and are not counted.
     pub fn fit(&mut self, x: &[SVector<f64, D>]) -> Result<FitStats, SingularMoments> {
-        self.gather_weights(x);
-        let stats = self.solve()?;
-        self.finish_shape_functions();
+        // The basis size as a constant lets the per-entry loops over terms unroll.
+        match self.terms {
+            1 => self.fit_with::<1>(x),
+            2 => self.fit_with::<2>(x),
+            3 => self.fit_with::<3>(x),
+            MAX_TERMS => self.fit_with::<MAX_TERMS>(x),
+            t => unreachable!("no basis has {t} terms"),
+        }
+    }
+
+    fn fit_with<const T: usize>(
+        &mut self,
+        x: &[SVector<f64, D>],
+    ) -> Result<FitStats, SingularMoments> {
+        debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
+        self.gather_weights::<T>(x);
+        let stats = self.solve::<T>()?;
+        self.finish_shape_functions::<T>();
         Ok(stats)
     }
 
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
     /// the moment matrices, summed particle by particle in order.
-    fn gather_weights(&mut self, x: &[SVector<f64, D>]) {
-        let n = x.len() * self.stride;
-        self.point.resize(n, 0);
-        self.offset.resize(n, SVector::zeros());
-        self.phi.resize(n, 0.0);
+    fn gather_weights<const T: usize>(&mut self, x: &[SVector<f64, D>]) {
+        // Sized for the most entries once; indexed writes are cheaper than pushes.
+        let capacity = x.len() * self.max_entries;
+        self.point.resize(capacity, 0);
+        self.offset.resize(capacity, SVector::zeros());
+        self.phi.resize(capacity, 0.0);
+        self.start.resize(x.len() + 1, 0);
         self.moments.fill(0.0);
-        let mut near = [[(0usize, 0.0f64); MAX_PER_AXIS]; D];
-        // The weight is a tensor product: its 1D factors are computed once per axis.
+        // Borrowed apart so the loop keeps them in registers.
+        let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
+        let (point, offset, phi) = (&mut self.point[..], &mut self.offset[..], &mut self.phi[..]);
+        let (start, moments) = (&mut self.start[..], &mut self.moments[..]);
+        let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
+        // Per axis and neighbour: the part of the lattice index, the offset and the 1D
+        // weight factor, so each entry only combines them.
+        let mut index = [[0usize; MAX_PER_AXIS]; D];
+        let mut axis_offset = [[0.0f64; MAX_PER_AXIS]; D];
         let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
         let mut count = [0usize; D];
         let inv_scale = 1.0 / self.recipe.kernel.scale;
         let weight = self.recipe.kernel.weight;
         let mut q = [0.0; MAX_TERMS];
-        let t = self.terms;
+        let mut entry = 0;
         for (p, xp) in x.iter().enumerate() {
             for k in 0..D {
-                count[k] = self
-                    .lattice
-                    .near_on_axis(k, xp[k], self.radius, &mut near[k]);
-                for j in 0..count[k] {
-                    axis_weight[k][j] = weight.eval(near[k][j].1.abs() * inv_scale);
+                count[k] = lattice.near_on_axis(k, xp[k], radius, &mut near);
+                for (j, &(i, dk)) in near[..count[k]].iter().enumerate() {
+                    index[k][j] = i * lattice.stride(k);
+                    axis_offset[k][j] = -dk;
+                    axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
                 }
             }
-            let base = p * self.stride;
             let total: usize = count.iter().product();
-            for slot in 0..self.stride {
-                let entry = base + slot;
-                if slot >= total {
-                    self.point[entry] = 0;
-                    self.phi[entry] = 0.0;
-                    continue;
-                }
-                let mut rest = slot;
+            // An odometer over the per-axis neighbours, the first axis fastest.
+            let mut j = [0usize; D];
+            for _ in 0..total {
                 let mut e = 0;
                 let mut w = 1.0;
                 let mut d = SVector::<f64, D>::zeros();
                 for k in 0..D {
-                    let j = rest % count[k];
-                    rest /= count[k];
-                    let (i, dk) = near[k][j];
-                    e += i * self.lattice.stride(k);
-                    d[k] = -dk;
-                    w *= axis_weight[k][j];
+                    e += index[k][j[k]];
+                    d[k] = axis_offset[k][j[k]];
+                    w *= axis_weight[k][j[k]];
                 }
-                self.point[entry] = e as u32;
-                self.offset[entry] = d;
-                self.phi[entry] = w;
-                monomials(self.recipe.degree, &d, &mut q);
-                add_weighted_outer(&mut self.moments[e * t * t..(e + 1) * t * t], t, w, &q[..t]);
+                for k in 0..D {
+                    j[k] += 1;
+                    if j[k] < count[k] {
+                        break;
+                    }
+                    j[k] = 0;
+                }
+                point[entry] = e as u32;
+                offset[entry] = d;
+                phi[entry] = w;
+                entry += 1;
+                monomials(degree, &d, &mut q);
+                add_weighted_outer(&mut moments[e * T * T..][..T * T], T, w, &q[..T]);
             }
+            start[p + 1] = entry;
         }
     }
 
     /// The coefficients c_e at every evaluation point.
-    fn solve(&mut self) -> Result<FitStats, SingularMoments> {
-        let t = self.terms;
+    fn solve<const T: usize>(&mut self) -> Result<FitStats, SingularMoments> {
         let mut stats = FitStats::default();
         for e in 0..self.lattice.len() {
-            let a = &self.moments[e * t * t..(e + 1) * t * t];
-            let c = &mut self.coeffs[e * t..(e + 1) * t];
+            let a = &self.moments[e * T * T..][..T * T];
+            let c = &mut self.coeffs[e * T..][..T];
             self.covered[e] = a[0] > 0.0;
             if !self.covered[e] {
                 c.fill(0.0);
                 continue;
             }
-            let mut full: Moments = [0.0; MAX_TERMS * MAX_TERMS];
-            for r in 0..t {
-                full[r * MAX_TERMS..r * MAX_TERMS + t].copy_from_slice(&a[r * t..(r + 1) * t]);
-            }
             stats.fits += 1;
             let solved = match self.recipe.solver {
-                Solver::Mls => mls_coefficients(&full, t).ok_or_else(|| SingularMoments {
+                Solver::Mls => mls_coefficients(a, T, T).ok_or_else(|| SingularMoments {
                     point: e,
                     position: self.lattice.point(e).iter().copied().collect(),
                 })?,
                 Solver::Imls => {
-                    let basis = OrthogonalBasis::from_moments(&full, t);
-                    if basis.rank() < t {
+                    let basis = OrthogonalBasis::from_rows(a, T, T);
+                    if basis.rank() < T {
                         stats.rank_deficient += 1;
                     }
                     basis.shape_coefficients()
                 }
             };
-            c.copy_from_slice(&solved[..t]);
+            c.copy_from_slice(&solved[..T]);
         }
         Ok(stats)
     }
 
     /// Pass two: phi_p(x_e) = w q((x_p - x_e)/h) . c_e for every entry.
-    fn finish_shape_functions(&mut self) {
-        let t = self.terms;
+    fn finish_shape_functions<const T: usize>(&mut self) {
         let mut q = [0.0; MAX_TERMS];
-        for entry in 0..self.phi.len() {
-            let w = self.phi[entry];
+        let degree = degree_of::<T, D>();
+        let entries = self.start.last().copied().unwrap_or(0);
+        let phis = &mut self.phi[..entries];
+        let coeffs = &self.coeffs[..];
+        for ((phi, &e), d) in phis.iter_mut().zip(&self.point).zip(&self.offset) {
+            let w = *phi;
             if w == 0.0 {
                 continue;
             }
-            let e = self.point[entry] as usize;
-            monomials(self.recipe.degree, &self.offset[entry], &mut q);
-            let c = &self.coeffs[e * t..(e + 1) * t];
-            self.phi[entry] = w * (0..t).map(|j| q[j] * c[j]).sum::<f64>();
+            monomials(degree, d, &mut q);
+            let c = &coeffs[e as usize * T..][..T];
+            *phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
         }
     }
 
@@ -269,12 +294,16 @@ impl<const D: usize> Reconstructor<D> {
         T: Copy + Zero + AddAssign + Mul<f64, Output = T>,
     {
         out.fill(T::zero());
-        for (p, &value) in values.iter().enumerate() {
-            let base = p * self.stride;
-            for entry in base..base + self.stride {
-                let phi = self.phi[entry];
+        assert!(
+            values.len() < self.start.len(),
+            "more values than fitted particles"
+        );
+        let (point, phi) = (&self.point[..], &self.phi[..]);
+        for (&value, ends) in values.iter().zip(self.start.windows(2)) {
+            let entries = ends[0]..ends[1];
+            for (&e, &phi) in point[entries.clone()].iter().zip(&phi[entries]) {
                 if phi != 0.0 {
-                    out[self.point[entry] as usize] += value * phi;
+                    out[e as usize] += value * phi;
                 }
             }
         }

@@ -63,6 +63,13 @@ pub struct OrthogonalBasis {
 
 impl OrthogonalBasis {
     pub fn from_moments(a: &Moments, terms: usize) -> Self {
+        Self::from_rows(a, MAX_TERMS, terms)
+    }
+
+    /// `from_moments` of a row-major matrix with row length `stride`. Always inlined so that
+    /// callers with a fixed basis size get the loops unrolled.
+    #[inline(always)]
+    pub(super) fn from_rows(a: &[f64], stride: usize, terms: usize) -> Self {
         let mut basis = OrthogonalBasis {
             terms,
             coeffs: [[0.0; MAX_TERMS]; MAX_TERMS],
@@ -77,16 +84,16 @@ impl OrthogonalBasis {
                     continue;
                 }
                 let ck = &basis.coeffs[k];
-                let q_i_dot_p_k: f64 = (0..=k).map(|j| ck[j] * a[i * MAX_TERMS + j]).sum();
+                let q_i_dot_p_k: f64 = (0..=k).map(|j| ck[j] * a[i * stride + j]).sum();
                 let ratio = q_i_dot_p_k / basis.norms[k];
                 for j in 0..=k {
                     c[j] -= ratio * ck[j];
                 }
             }
-            let norm = quadratic_form(a, &c, i + 1);
+            let norm = quadratic_form(a, stride, &c, i + 1);
             basis.coeffs[i] = c;
             basis.norms[i] = norm;
-            basis.kept[i] = norm > RANK_TOLERANCE * a[i * MAX_TERMS + i];
+            basis.kept[i] = norm > RANK_TOLERANCE * a[i * stride + i];
         }
         basis
     }
@@ -102,6 +109,7 @@ impl OrthogonalBasis {
 
     /// c of phi_p = w_p q_p . c: u^h = sum_i p_i(x) <p_i, u>/<p_i, p_i> (eq 11, 13) with
     /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point.
+    #[inline]
     pub fn shape_coefficients(&self) -> [f64; MAX_TERMS] {
         let mut first = [0.0; MAX_TERMS];
         first[0] = 1.0;
@@ -111,6 +119,7 @@ impl OrthogonalBasis {
     /// The least-squares coefficients c of sum_j c_j q_j from rhs_j = <q_j, u>:
     /// c = sum_i p_i <p_i, u>/<p_i, p_i> over the kept polynomials (the pseudo-inverse of the
     /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j.
+    #[inline]
     pub fn solve(&self, rhs: &[f64; MAX_TERMS]) -> [f64; MAX_TERMS] {
         let mut out = [0.0; MAX_TERMS];
         for i in 0..self.terms {
@@ -127,22 +136,29 @@ impl OrthogonalBasis {
     }
 }
 
-/// c^T A c over the leading `n` entries.
-fn quadratic_form(a: &Moments, c: &[f64; MAX_TERMS], n: usize) -> f64 {
+/// c^T A c over the leading `n` entries, A row-major with row length `stride`.
+#[inline(always)]
+fn quadratic_form(a: &[f64], stride: usize, c: &[f64; MAX_TERMS], n: usize) -> f64 {
     let mut sum = 0.0;
     for i in 0..n {
-        let row: f64 = (0..n).map(|j| a[i * MAX_TERMS + j] * c[j]).sum();
+        let row: f64 = (0..n).map(|j| a[i * stride + j] * c[j]).sum();
         sum += c[i] * row;
     }
     sum
 }
 
-/// MLS: c = A^-1 e_1 by Gaussian elimination with partial pivoting (Gong sec 5.4). `None`
-/// when a pivot is at most `RANK_TOLERANCE` times the largest diagonal entry.
-pub fn mls_coefficients(a: &Moments, terms: usize) -> Option<[f64; MAX_TERMS]> {
+/// MLS: c = A^-1 e_1 by Gaussian elimination with partial pivoting (Gong sec 5.4), A
+/// row-major with row length `stride`. `None` when a pivot is at most `RANK_TOLERANCE` times
+/// the largest diagonal entry. Always inlined so that callers with a fixed basis size get
+/// the loops unrolled.
+#[inline(always)]
+pub fn mls_coefficients(a: &[f64], stride: usize, terms: usize) -> Option<[f64; MAX_TERMS]> {
     let n = terms;
-    let scale = (0..n).map(|i| a[i * MAX_TERMS + i]).fold(0.0, f64::max);
-    let mut m = *a;
+    let scale = (0..n).map(|i| a[i * stride + i]).fold(0.0, f64::max);
+    let mut m = [0.0; MAX_TERMS * MAX_TERMS];
+    for r in 0..n {
+        m[r * MAX_TERMS..r * MAX_TERMS + n].copy_from_slice(&a[r * stride..r * stride + n]);
+    }
     let mut rhs = [0.0; MAX_TERMS];
     rhs[0] = 1.0;
     for col in 0..n {
