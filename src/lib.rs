@@ -16,6 +16,7 @@ pub mod linear_stability;
 pub mod material;
 pub mod methods;
 pub mod output;
+pub mod parallel;
 pub mod params;
 pub mod particles;
 pub mod reconstruct;

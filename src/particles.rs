@@ -4,6 +4,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::benchmarks::Problem;
 use crate::fallible::filled;
+use crate::parallel;
 use crate::reconstruct::gauss_legendre_rule;
 use crate::shape::{lattice_coords, Grid};
 
@@ -132,4 +133,43 @@ impl<const D: usize> Particles<D> {
     pub fn volume(&self, p: usize) -> f64 {
         self.volume[p]
     }
+
+    /// The particles in consecutive chunks of `parallel::CHUNK`, one task each of a loop that
+    /// updates them.
+    pub fn chunks_mut(&mut self) -> impl Iterator<Item = ParticleChunk<'_, D>> {
+        let n = parallel::CHUNK;
+        self.x
+            .chunks_mut(n)
+            .zip(self.v.chunks_mut(n))
+            .zip(self.f.chunks_mut(n))
+            .zip(self.j.chunks_mut(n))
+            .zip(self.stress.chunks_mut(n))
+            .zip(self.volume.chunks_mut(n))
+            .zip(self.volume0.chunks(n))
+            .enumerate()
+            .map(
+                move |(c, ((((((x, v), f), j), stress), volume), volume0))| ParticleChunk {
+                    start: c * n,
+                    x,
+                    v,
+                    f,
+                    j,
+                    stress,
+                    volume,
+                    volume0,
+                },
+            )
+    }
+}
+
+/// Particles `start..start + x.len()` with the state a step updates writable, indexed from 0.
+pub struct ParticleChunk<'a, const D: usize> {
+    pub start: usize,
+    pub x: &'a mut [SVector<f64, D>],
+    pub v: &'a mut [SVector<f64, D>],
+    pub f: &'a mut [SMatrix<f64, D, D>],
+    pub j: &'a mut [f64],
+    pub stress: &'a mut [SMatrix<f64, D, D>],
+    pub volume: &'a mut [f64],
+    pub volume0: &'a [f64],
 }

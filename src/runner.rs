@@ -1,5 +1,6 @@
 //! Runs an expanded experiment: every run in parallel across a rayon pool, each written
-//! to its own file. Numbers do not depend on the pool size: each run is sequential. Processes
+//! to its own file, each run's loops over `threads` threads of its own. Numbers depend on
+//! neither count: the in-run loops give the sequential results bit for bit (`parallel`). Processes
 //! that run one experiment into one results directory at the same time share its runs
 //! (`runner/locks.rs`).
 
@@ -20,6 +21,7 @@ use crate::output::{
     compute_run, describe_if_missing, read_message, remove_dead_temps, run_path, write_atomically,
     write_run, RunRecord, RunStatus,
 };
+use crate::parallel::with_threads;
 use crate::params::get_usize;
 use crate::solver::{base_record, estimated_bytes, simulate_into};
 
@@ -31,8 +33,11 @@ pub const EXPERIMENT_COPY: &str = "experiment.yaml";
 pub struct RunOptions {
     /// Parent directory; the experiment writes into `<out>/<name>/`.
     pub out: PathBuf,
-    /// Worker threads (0 = one per core).
+    /// Runs at a time (0 = one per core, or per `threads` cores).
     pub jobs: usize,
+    /// Threads inside each run (1 = sequential), an execution setting like `jobs`: it is not
+    /// a parameter, so it changes neither run ids nor results.
+    pub threads: usize,
     /// Rerun runs whose file already exists.
     pub force: bool,
     /// Bytes the runs in progress may use together (default: the memory available).
@@ -108,7 +113,7 @@ fn run_pass<'a>(
 
     let progress = progress_bar(name, todo.len());
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.jobs)
+        .num_threads(parallel_runs(options))
         .build()
         .map_err(io::Error::other)?;
     let claims = locks::Claims::new(dir, options.force);
@@ -121,7 +126,11 @@ fn run_pass<'a>(
                     Some(message) => record_failure(dir, run, message),
                     None => {
                         let _hold = budget.hold(bytes);
-                        execute(dir, run, simulate_into)
+                        with_threads(options.threads, || execute(dir, run, simulate_into))
+                            .unwrap_or_else(|e| {
+                                let message = format!("its threads could not be started: {e}");
+                                record_failure(dir, run, message)
+                            })
                     }
                 };
                 if result.is_ok() {
@@ -152,6 +161,18 @@ fn run_pass<'a>(
     let waited = claims.wait_for_others(name)?;
     outcome.elsewhere += waited.elsewhere;
     Ok(waited.orphans)
+}
+
+/// Runs at a time: `jobs`, or by default as many as fill the cores with `threads` each
+/// (rayon's default of one per core when runs are sequential).
+fn parallel_runs(options: &RunOptions) -> usize {
+    match (options.jobs, options.threads) {
+        (0, 0 | 1) => 0,
+        (0, threads) => {
+            std::thread::available_parallelism().map_or(1, |cores| (cores.get() / threads).max(1))
+        }
+        (jobs, _) => jobs,
+    }
 }
 
 /// Whether the run is to be computed: it has no file, or its file records that it was refused

@@ -32,6 +32,7 @@ fn a_figure_of_two_listed_methods_draws_those_two() {
     let options = RunOptions {
         out: out.path().to_path_buf(),
         jobs: 2,
+        threads: 1,
         force: false,
         memory: None,
     };

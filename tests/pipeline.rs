@@ -24,6 +24,7 @@ fn options(out: &Path, jobs: usize, force: bool) -> RunOptions {
     RunOptions {
         out: out.to_path_buf(),
         jobs,
+        threads: 1,
         force,
         memory: None,
     }

@@ -35,6 +35,7 @@ fn run(name: &str, out: &Path) -> mpmlab::collect::Collected {
     let options = RunOptions {
         out: out.to_path_buf(),
         jobs: 2,
+        threads: 1,
         force: false,
         memory: None,
     };

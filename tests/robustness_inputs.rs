@@ -260,6 +260,7 @@ fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {
     let options = RunOptions {
         out: out.path().to_path_buf(),
         jobs: 1,
+        threads: 1,
         force: false,
         memory: None,
     };
@@ -389,6 +390,7 @@ fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
     let mut options = RunOptions {
         out: out.path().to_path_buf(),
         jobs: 2,
+        threads: 1,
         force: false,
         memory: Some(((need_small + need_large) / 2.0) as u64),
     };

@@ -39,6 +39,7 @@ fn runs_either_side_of_the_limit_are_told_apart() {
     let options = RunOptions {
         out: tmp.path().to_path_buf(),
         jobs: 2,
+        threads: 1,
         force: false,
         memory: None,
     };

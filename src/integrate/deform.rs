@@ -4,7 +4,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::Divergence;
 use crate::material::{det, Material};
-use crate::particles::Particles;
+use crate::parallel;
+use crate::particles::{ParticleChunk, Particles};
 use crate::shape::Stencils;
 
 /// F_p = (I + dt grad v_p) F_p, J_p = det F_p, V_p = J_p V_p^0 and the stress (from F, or
@@ -15,34 +16,36 @@ use crate::shape::Stencils;
 // of the 2D step.
 #[inline(always)]
 pub(super) fn deform_particle<const D: usize>(
-    particles: &mut Particles<D>,
-    p: usize,
+    chunk: &mut ParticleChunk<D>,
+    q: usize,
     grad_v: &SMatrix<f64, D, D>,
     dt: f64,
     accel_finite: bool,
     material: &Material,
 ) -> Result<(), Divergence> {
-    let f = (SMatrix::<f64, D, D>::identity() + grad_v * dt) * particles.f[p];
+    let particle = chunk.start + q;
+    let f = (SMatrix::<f64, D, D>::identity() + grad_v * dt) * chunk.f[q];
     let j = det(&f);
     if !(j.is_finite() && accel_finite) {
         return Err(Divergence::NonFinite {
-            particle: p,
+            particle,
             what: "state",
         });
     }
     if j <= 0.0 {
-        return Err(Divergence::Jacobian { particle: p, j });
+        return Err(Divergence::Jacobian { particle, j });
     }
-    particles.f[p] = f;
-    particles.j[p] = j;
-    particles.volume[p] = j * particles.volume0[p];
-    particles.stress[p] = material.stress(&particles.stress[p], &f, j, grad_v, dt);
+    chunk.f[q] = f;
+    chunk.j[q] = j;
+    chunk.volume[q] = j * chunk.volume0[q];
+    chunk.stress[q] = material.stress(&chunk.stress[q], &f, j, grad_v, dt);
     Ok(())
 }
 
 /// grad v_p = sum_i v_i (x) grad N_ip from the nodal velocity `velocity`, then F, J and the
 /// stress of every particle: MUSL's eqs 37-40 of Tran et al. with v_i^L (eq 37 prints N), and
-/// the predictor-corrector's steps 4-5 with v~_i.
+/// the predictor-corrector's steps 4-5 with v~_i. Chunks of particles run in parallel
+/// (`parallel::map_chunks`); the error is that of the first particle that failed.
 pub fn deform_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
@@ -50,12 +53,17 @@ pub fn deform_particles<const D: usize>(
     dt: f64,
     material: &Material,
 ) -> Result<(), Divergence> {
-    for p in 0..particles.len() {
-        let grad_v: SMatrix<f64, D, D> = stencils
-            .of(p)
-            .map(|(i, _, g)| velocity[i] * g.transpose())
-            .sum();
-        deform_particle(particles, p, &grad_v, dt, true, material)?;
-    }
-    Ok(())
+    let deform = |mut chunk: ParticleChunk<D>| {
+        for q in 0..chunk.f.len() {
+            let grad_v: SMatrix<f64, D, D> = stencils
+                .of(chunk.start + q)
+                .map(|(i, _, g)| velocity[i] * g.transpose())
+                .sum();
+            deform_particle(&mut chunk, q, &grad_v, dt, true, material)?;
+        }
+        Ok(())
+    };
+    parallel::map_chunks(particles.chunks_mut(), deform)
+        .into_iter()
+        .collect()
 }

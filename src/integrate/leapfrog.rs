@@ -9,7 +9,8 @@ use nalgebra::{SMatrix, SVector};
 use super::deform::deform_particle;
 use super::Divergence;
 use crate::material::Material;
-use crate::particles::Particles;
+use crate::parallel;
+use crate::particles::{ParticleChunk, Particles};
 use crate::reconstruct::GridState;
 use crate::shape::Stencils;
 
@@ -21,7 +22,8 @@ use crate::shape::Stencils;
 ///
 /// The particles move with the nodal velocity `drift`: the updated one `grid.velocity_new`
 /// (leapfrog, USL) or the start-of-step one `grid.velocity` (forward Euler, Molinos et al.
-/// eq 22); F always follows `grid.velocity_new`.
+/// eq 22); F always follows `grid.velocity_new`. Chunks of particles run in parallel
+/// (`parallel::map_chunks`); the error is that of the first particle that failed.
 pub fn update_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
@@ -31,21 +33,26 @@ pub fn update_particles<const D: usize>(
     dt: f64,
     material: &Material,
 ) -> Result<(), Divergence> {
-    for p in 0..particles.len() {
-        let mut a = SVector::<f64, D>::zeros();
-        let mut v = SVector::<f64, D>::zeros();
-        let mut grad_v = SMatrix::<f64, D, D>::zeros();
-        for (i, w, g) in stencils.of(p) {
-            a += grid.force[i] * w;
-            v += drift[i] * w;
-            grad_v += grid.velocity_new[i] * g.transpose();
+    let update = |mut chunk: ParticleChunk<D>| {
+        for q in 0..chunk.x.len() {
+            let mut a = SVector::<f64, D>::zeros();
+            let mut v = SVector::<f64, D>::zeros();
+            let mut grad_v = SMatrix::<f64, D, D>::zeros();
+            for (i, w, g) in stencils.of(chunk.start + q) {
+                a += grid.force[i] * w;
+                v += drift[i] * w;
+                grad_v += grid.velocity_new[i] * g.transpose();
+            }
+            chunk.v[q] += a * kick;
+            chunk.x[q] += v * dt;
+            let finite = a.iter().all(|c| c.is_finite());
+            deform_particle(&mut chunk, q, &grad_v, dt, finite, material)?;
         }
-        particles.v[p] += a * kick;
-        particles.x[p] += v * dt;
-        let finite = a.iter().all(|c| c.is_finite());
-        deform_particle(particles, p, &grad_v, dt, finite, material)?;
-    }
-    Ok(())
+        Ok(())
+    };
+    parallel::map_chunks(particles.chunks_mut(), update)
+        .into_iter()
+        .collect()
 }
 
 /// Particle velocities at the integer time level s: v_p^s = v_p^{s-1/2} + half sum_i N_ip a_i

@@ -1,6 +1,7 @@
 use nalgebra::SVector;
 
 use super::GridState;
+use crate::parallel;
 use crate::particles::Particles;
 use crate::shape::Stencils;
 
@@ -9,7 +10,8 @@ use crate::shape::Stencils;
 /// zero at empty nodes),
 /// and force f_i = -sum_p V_p sigma_p grad N_ip + sum_p M_p b_p N_ip by one-point
 /// quadrature at the particles (V_p sigma_p = M_p sigma_p / rho_p, Gong's M_p sigma^s_p).
-/// Particles are visited in order, so the sums are the same on every run.
+/// Particles are visited in order at every node, so the sums are the same on every run and
+/// for any thread count.
 pub fn particles_to_grid<const D: usize>(
     stencils: &Stencils<D>,
     particles: &Particles<D>,
@@ -29,17 +31,28 @@ pub fn particle_sums<const D: usize>(
     grid: &mut GridState<D>,
 ) {
     grid.clear();
-    for p in 0..particles.len() {
+    let len = parallel::block_len(grid.mass.len());
+    let blocks = grid
+        .mass
+        .chunks_mut(len)
+        .zip(grid.velocity.chunks_mut(len))
+        .zip(grid.force.chunks_mut(len));
+    let point = |p: usize| {
         let m = particles.mass[p];
-        let mv = particles.v[p] * m;
         let vs = particles.stress[p] * particles.volume(p);
-        let mb = body_force[p] * m;
-        for (i, w, g) in stencils.of(p) {
-            grid.mass[i] += m * w;
-            grid.velocity[i] += mv * w;
-            grid.force[i] += mb * w - vs * g;
-        }
-    }
+        (m, particles.v[p] * m, vs, body_force[p] * m)
+    };
+    stencils.scatter(
+        particles.len(),
+        len,
+        blocks,
+        point,
+        |((mass, velocity), force), i, (m, mv, vs, mb), w, g| {
+            mass[i] += m * w;
+            velocity[i] += mv * w;
+            force[i] += mb * w - vs * g;
+        },
+    );
 }
 
 /// The Shepard mapping of mass and of one velocity per particle, with no forces: m_i as in
@@ -52,13 +65,19 @@ pub fn map_velocity<const D: usize>(
     grid: &mut GridState<D>,
 ) {
     grid.clear();
-    for (p, (&m, u)) in mass.iter().zip(velocity).enumerate() {
-        let mu = u * m;
-        for (i, w, _) in stencils.of(p) {
-            grid.mass[i] += m * w;
-            grid.velocity[i] += mu * w;
-        }
-    }
+    let len = parallel::block_len(grid.mass.len());
+    let blocks = grid.mass.chunks_mut(len).zip(grid.velocity.chunks_mut(len));
+    let point = |p: usize| (mass[p], velocity[p] * mass[p]);
+    stencils.scatter(
+        mass.len(),
+        len,
+        blocks,
+        point,
+        |(nodal_mass, momentum), i, (m, mu), w, _| {
+            nodal_mass[i] += m * w;
+            momentum[i] += mu * w;
+        },
+    );
     momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
 }
 
@@ -71,13 +90,18 @@ pub fn nodal_forces<const D: usize>(
     force: &mut [SVector<f64, D>],
 ) {
     force.fill(SVector::zeros());
-    for p in 0..particles.len() {
+    let len = parallel::block_len(force.len());
+    let point = |p: usize| {
         let vs = particles.stress[p] * particles.volume(p);
-        let mb = body_force[p] * particles.mass[p];
-        for (i, w, g) in stencils.of(p) {
-            force[i] += mb * w - vs * g;
-        }
-    }
+        (vs, body_force[p] * particles.mass[p])
+    };
+    stencils.scatter(
+        particles.len(),
+        len,
+        force.chunks_mut(len),
+        point,
+        |force, i, (vs, mb), w, g| force[i] += mb * w - vs * g,
+    );
 }
 
 /// MUSL's v_i^L for the Shepard mapping: sum_p M_p v_p N_ip / m_i with this step's weights
@@ -100,12 +124,14 @@ pub fn momentum_sums<const D: usize>(
     out: &mut [SVector<f64, D>],
 ) {
     out.fill(SVector::zeros());
-    for p in 0..particles.len() {
-        let mv = particles.v[p] * particles.mass[p];
-        for (i, w, _) in stencils.of(p) {
-            out[i] += mv * w;
-        }
-    }
+    let len = parallel::block_len(out.len());
+    stencils.scatter(
+        particles.len(),
+        len,
+        out.chunks_mut(len),
+        |p| particles.v[p] * particles.mass[p],
+        |out, i, mv, w, _| out[i] += mv * w,
+    );
 }
 
 /// Divides nodal momenta by the nodal masses; empty nodes are left at rest.

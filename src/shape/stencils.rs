@@ -1,6 +1,7 @@
 use nalgebra::SVector;
 
 use crate::fallible::filled;
+use crate::parallel;
 
 use super::{Grid, Shape};
 
@@ -24,8 +25,8 @@ impl<const D: usize> Stencils<D> {
         }
     }
 
-    /// Evaluates the shape functions at every position; on failure returns the index of
-    /// the first particle outside the grid.
+    /// Evaluates the shape functions at every position, `parallel::CHUNK` positions per task;
+    /// on failure returns the index of the first particle outside the grid.
     pub fn update<S: Shape<D> + ?Sized>(
         &mut self,
         shape: &S,
@@ -33,17 +34,86 @@ impl<const D: usize> Stencils<D> {
         positions: &[SVector<f64, D>],
     ) -> Result<(), usize> {
         let k = self.per_point;
+        let len = k * parallel::CHUNK;
         let chunks = self
             .node
-            .chunks_exact_mut(k)
-            .zip(self.weight.chunks_exact_mut(k))
-            .zip(self.grad.chunks_exact_mut(k));
-        for (p, ((node, weight), grad)) in chunks.enumerate() {
-            if !shape.eval(grid, &positions[p], node, weight, grad) {
-                return Err(p);
+            .chunks_mut(len)
+            .zip(self.weight.chunks_mut(len))
+            .zip(self.grad.chunks_mut(len))
+            .zip(positions.chunks(parallel::CHUNK))
+            .enumerate();
+        type Chunk<'a, const D: usize> = (
+            usize,
+            (
+                ((&'a mut [u32], &'a mut [f64]), &'a mut [SVector<f64, D>]),
+                &'a [SVector<f64, D>],
+            ),
+        );
+        let evaluate = |(c, (((node, weight), grad), positions)): Chunk<D>| {
+            let entries = node
+                .chunks_exact_mut(k)
+                .zip(weight.chunks_exact_mut(k))
+                .zip(grad.chunks_exact_mut(k));
+            for (q, ((node, weight), grad)) in entries.enumerate() {
+                if !shape.eval(grid, &positions[q], node, weight, grad) {
+                    return Err(c * parallel::CHUNK + q);
+                }
             }
-        }
-        Ok(())
+            Ok(())
+        };
+        parallel::map_chunks(chunks, evaluate).into_iter().collect()
+    }
+
+    /// Adds the contributions of points `0..points` to nodal arrays cut into blocks of
+    /// `block_len` nodes (`blocks`, in node order): `add(block, i - start, value, N_ip, grad
+    /// N_ip)` for each of point p's entries whose node i lies in the block starting at
+    /// `start`, with `value = point(p)` computed once per point and block it reaches. Each
+    /// block's task walks the points in order, so every node's sum is in point order
+    /// whatever the blocks, and blocks run in parallel (`parallel::map_chunks`).
+    pub fn scatter<B: Send, T>(
+        &self,
+        points: usize,
+        block_len: usize,
+        blocks: impl Iterator<Item = B>,
+        point: impl Fn(usize) -> T + Sync,
+        add: impl Fn(&mut B, usize, &T, f64, &SVector<f64, D>) + Sync,
+    ) {
+        let k = self.per_point;
+        // The nodes each chunk of points reaches, so that a block's task skips the chunks that
+        // add nothing to it: points seeded along the grid give each task about its share.
+        let reach = |nodes: &[u32]| {
+            let lo = nodes.iter().min().map_or(usize::MAX, |&i| i as usize);
+            let hi = nodes.iter().max().map_or(0, |&i| i as usize);
+            (lo, hi)
+        };
+        let reaches = parallel::map_chunks(
+            self.node[..points * k].chunks((k * parallel::CHUNK).max(1)),
+            reach,
+        );
+        let fill = |(b, mut block): (usize, B)| {
+            let start = b * block_len;
+            let inside = start..start + block_len;
+            for (c, &(lo, hi)) in reaches.iter().enumerate() {
+                if hi < start || lo >= inside.end {
+                    continue;
+                }
+                for p in c * parallel::CHUNK..((c + 1) * parallel::CHUNK).min(points) {
+                    let range = p * k..(p + 1) * k;
+                    let nodes = &self.node[range.clone()];
+                    if !nodes.iter().any(|&i| inside.contains(&(i as usize))) {
+                        continue;
+                    }
+                    let value = point(p);
+                    let entries = nodes.iter().zip(&self.weight[range.clone()]);
+                    for ((&i, &w), g) in entries.zip(&self.grad[range]) {
+                        if inside.contains(&(i as usize)) {
+                            add(&mut block, i as usize - start, &value, w, g);
+                        }
+                    }
+                }
+            }
+        };
+        parallel::map_chunks(blocks.enumerate(), fill);
     }
 
     /// The largest distance between two node numbers in one point's stencil: the

@@ -19,6 +19,7 @@ use crate::integrate::predictor_corrector::PredictorCorrector;
 use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
+use crate::parallel;
 use crate::particles::Particles;
 use crate::reconstruct::{nodal_forces, FitStats, GridState};
 use crate::shape::{
@@ -350,15 +351,33 @@ impl<'a, const D: usize> Run<'a, D> {
     fn locate_particles(&mut self) -> Result<(), Divergence> {
         let first = self.cells.is_empty();
         self.cells.resize(self.particles.len(), usize::MAX);
-        for (p, x) in self.particles.x.iter().enumerate() {
-            let (cell, _) = self
-                .grid
-                .locate(x)
-                .ok_or(Divergence::LeftGrid { particle: p })?;
-            let cell = self.grid.cell_index(cell);
-            if cell != self.cells[p] {
-                self.cells[p] = cell;
-                self.grid_crossings += usize::from(!first);
+        let grid = &self.grid;
+        let chunks = self
+            .cells
+            .chunks_mut(parallel::CHUNK)
+            .zip(self.particles.x.chunks(parallel::CHUNK))
+            .enumerate();
+        // Each chunk's crossings up to its first particle off the grid, if any; the count
+        // stops at the first such particle of all, as a sequential pass would.
+        let locate = |(c, (cells, x)): (usize, (&mut [usize], &[SVector<f64, D>]))| {
+            let mut crossings = 0;
+            for (q, (cell, x)) in cells.iter_mut().zip(x).enumerate() {
+                let Some((found, _)) = grid.locate(x) else {
+                    let particle = c * parallel::CHUNK + q;
+                    return (crossings, Some(Divergence::LeftGrid { particle }));
+                };
+                let found = grid.cell_index(found);
+                if found != *cell {
+                    *cell = found;
+                    crossings += usize::from(!first);
+                }
+            }
+            (crossings, None)
+        };
+        for (crossings, left) in parallel::map_chunks(chunks, locate) {
+            self.grid_crossings += crossings;
+            if let Some(reason) = left {
+                return Err(reason);
             }
         }
         Ok(())
