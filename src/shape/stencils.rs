@@ -79,6 +79,22 @@ impl<const D: usize> Stencils<D> {
         add: impl Fn(&mut B, usize, &T, f64, &SVector<f64, D>) + Sync,
     ) {
         let k = self.per_point;
+        let mut blocks: Vec<B> = blocks.collect();
+        if let [block] = blocks.as_mut_slice() {
+            // One block holds every node (one thread): the plain loop, without the tests
+            // that keep a block's task to its nodes.
+            for p in 0..points {
+                let value = point(p);
+                let range = p * k..(p + 1) * k;
+                let entries = self.node[range.clone()]
+                    .iter()
+                    .zip(&self.weight[range.clone()]);
+                for ((&i, &w), g) in entries.zip(&self.grad[range]) {
+                    add(block, i as usize, &value, w, g);
+                }
+            }
+            return;
+        }
         // The nodes each chunk of points reaches, so that a block's task skips the chunks that
         // add nothing to it: points seeded along the grid give each task about its share.
         let reach = |nodes: &[u32]| {
@@ -113,7 +129,7 @@ impl<const D: usize> Stencils<D> {
                 }
             }
         };
-        parallel::map_chunks(blocks.enumerate(), fill);
+        parallel::map_chunks(blocks.into_iter().enumerate(), fill);
     }
 
     /// The largest distance between two node numbers in one point's stencil: the
