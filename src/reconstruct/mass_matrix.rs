@@ -104,11 +104,12 @@ impl<const D: usize> MassSolver<D> {
         if self.direct {
             return self.factor(mass, empty_mass);
         }
+        let fixed = &self.fixed;
         for (k, inverse) in self.inverse_lumped.iter_mut().enumerate() {
             inverse.clear();
-            inverse.extend(mass.iter().zip(&self.fixed).map(|(&m, fixed)| {
-                if m > empty_mass && !fixed[k] {
-                    1.0 / m
+            inverse.extend((0..mass.len()).map(|i| {
+                if solved_for(fixed, mass, empty_mass, i, k) {
+                    1.0 / mass[i]
                 } else {
                     0.0
                 }
@@ -126,7 +127,7 @@ impl<const D: usize> MassSolver<D> {
             free.clear();
             free.extend(
                 (0..mass.len())
-                    .filter(|&i| mass[i] > empty_mass && !self.fixed[i][k])
+                    .filter(|&i| solved_for(&self.fixed, mass, empty_mass, i, k))
                     .map(|i| i as u32),
             );
             let shared = (0..k).find(|&l| self.free[self.factor_of[l]] == free);
@@ -192,10 +193,9 @@ impl<const D: usize> MassSolver<D> {
     ) -> Result<(), Divergence> {
         if self.kind == MassMatrix::Lumped {
             for (i, x) in field.iter_mut().enumerate() {
-                let m = mass[i];
                 for k in 0..D {
-                    x[k] = if m > empty_mass && !self.fixed[i][k] {
-                        x[k] / m
+                    x[k] = if solved_for(&self.fixed, mass, empty_mass, i, k) {
+                        x[k] / mass[i]
                     } else {
                         0.0
                     };
@@ -203,37 +203,30 @@ impl<const D: usize> MassSolver<D> {
             }
             return Ok(());
         }
-        let mut rhs = std::mem::take(&mut self.rhs);
-        let mut solved = Ok(());
+        let rhs = &mut self.rhs;
         for k in 0..D {
             rhs.clear();
             if self.direct {
                 let free = &self.free[k];
                 rhs.extend(free.iter().map(|&i| field[i as usize][k]));
-                self.factors[self.factor_of[k]].solve(&mut rhs);
+                self.factors[self.factor_of[k]].solve(rhs);
                 for x in field.iter_mut() {
                     x[k] = 0.0;
                 }
-                for (&i, &x) in free.iter().zip(&rhs) {
+                for (&i, &x) in free.iter().zip(rhs.iter()) {
                     field[i as usize][k] = x;
                 }
-                continue;
-            }
-            rhs.extend(field.iter().map(|x| x[k]));
-            solved = self
-                .iterations
-                .solve(&self.matrix, &self.inverse_lumped[k], &mut rhs)
-                .map(|_| ())
-                .map_err(breakdown_message);
-            if solved.is_err() {
-                break;
-            }
-            for (x, &value) in field.iter_mut().zip(&rhs) {
-                x[k] = value;
+            } else {
+                rhs.extend(field.iter().map(|x| x[k]));
+                self.iterations
+                    .solve(&self.matrix, &self.inverse_lumped[k], rhs)
+                    .map_err(breakdown_message)?;
+                for (x, &value) in field.iter_mut().zip(rhs.iter()) {
+                    x[k] = value;
+                }
             }
         }
-        self.rhs = rhs;
-        solved
+        Ok(())
     }
 
     /// The grid solve with this matrix: a = M^-1 f, v_new = v + kick a, fixed components
@@ -245,6 +238,18 @@ impl<const D: usize> MassSolver<D> {
         }
         Ok(())
     }
+}
+
+/// Whether component k of DOF i is solved for: it carries mass and is not held.
+#[inline]
+fn solved_for<const D: usize>(
+    fixed: &[[bool; D]],
+    mass: &[f64],
+    empty_mass: f64,
+    i: usize,
+    k: usize,
+) -> bool {
+    mass[i] > empty_mass && !fixed[i][k]
 }
 
 fn breakdown_message(breakdown: Breakdown) -> Divergence {
