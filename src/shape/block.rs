@@ -15,18 +15,22 @@ fn last_start<const D: usize>(grid: &Grid<D>, per_axis: usize) -> usize {
     grid.cells.saturating_sub(per_axis - 1)
 }
 
-/// The first node of the stencil block along each axis for a bounding box [lo, hi] (in cell
-/// units from the grid's lower corner), or `None` when the box spans more cells than a block.
+/// The first node along each axis of a block of `per_axis` nodes per axis that holds the hat
+/// supports reaching a bounding box [lo, hi] (in cell units from the grid's lower corner), or
+/// `None` when the box spans more cells than the block. Blocks of different widths start at the
+/// same node except where the grid ends, so a narrower block lists the same nonzero entries in
+/// the same order.
 pub fn block_start<const D: usize>(
     grid: &Grid<D>,
     lo: &SVector<f64, D>,
     hi: &SVector<f64, D>,
+    per_axis: usize,
 ) -> Option<[usize; D]> {
-    let last_start = last_start(grid, NODES_PER_AXIS);
+    let last_start = last_start(grid, per_axis);
     let mut start = [0; D];
     for k in 0..D {
         start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
-        if hi[k] > (start[k] + NODES_PER_AXIS - 1) as f64 {
+        if hi[k] > (start[k] + per_axis - 1) as f64 {
             return None;
         }
     }
@@ -71,4 +75,30 @@ pub fn block_node<const D: usize>(
         index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
     }
     (index, local)
+}
+
+/// Calls `visit(e, index, local)` for the entries `e = 0, 1, ...` of a block of `per_axis` nodes
+/// per axis starting at `start`: what `block_node` gives for each, counted up axis by axis
+/// instead of divided out, as the per-particle stencils need it for every entry.
+#[inline]
+pub fn for_each_block_node<const D: usize>(
+    grid: &Grid<D>,
+    start: &[usize; D],
+    per_axis: usize,
+    mut visit: impl FnMut(usize, usize, &[usize; D]),
+) {
+    let mut local = [0; D];
+    for e in 0..per_axis.pow(D as u32) {
+        let index = (0..D)
+            .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
+            .sum();
+        visit(e, index, &local);
+        for k in 0..D {
+            local[k] += 1;
+            if local[k] < per_axis {
+                break;
+            }
+            local[k] = 0;
+        }
+    }
 }

@@ -25,6 +25,12 @@ impl<const D: usize> Stencils<D> {
         }
     }
 
+    /// Gives every point `per_point` entries, all zero until filled again.
+    pub fn reshape(&mut self, per_point: usize) {
+        let points = self.node.len() / self.per_point.max(1);
+        *self = Stencils::new(per_point, points);
+    }
+
     /// Evaluates the shape functions at every position, `parallel::CHUNK` positions per task;
     /// on failure returns the index of the first particle outside the grid.
     pub fn update<S: Shape<D> + ?Sized>(

@@ -188,7 +188,10 @@ impl<'a, const D: usize> Run<'a, D> {
                 Basis::LocalMaxEnt(lme)
             }
         };
-        let per_point = footprint::stencil_nodes::<D>(method.shape);
+        let per_point = match method.shape {
+            ShapeKind::Domain(_) => ParticleDomains::<D>::narrow_nodes_per_point(),
+            shape => footprint::stencil_nodes::<D>(shape),
+        };
         Run {
             spec,
             method,

@@ -14,7 +14,7 @@ use std::fmt;
 
 use nalgebra::SVector;
 
-use super::block::{block_node, block_start, NODES_PER_AXIS};
+use super::block::{block_start, for_each_block_node, NODES_PER_AXIS};
 use super::{lattice_coords, lattice_strides, Grid, LinearHat, Shape, Stencils};
 use crate::particles::Particles;
 use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
@@ -78,6 +78,10 @@ impl fmt::Display for DomainFault {
     }
 }
 
+/// Nodes per axis in a stencil while every domain's box ends within two cells of the cell its
+/// lower corner lies in, as every domain at most a cell wide does.
+const NARROW_PER_AXIS: usize = 3;
+
 /// The domains of all particles and what is needed to evaluate their effective basis.
 pub struct ParticleDomains<const D: usize> {
     shape: DomainShape,
@@ -124,13 +128,39 @@ impl<const D: usize> ParticleDomains<D> {
         domains
     }
 
+    /// The most nodes a stencil holds: a domain may span up to `NODES_PER_AXIS - 1` cells.
     pub fn nodes_per_point() -> usize {
         NODES_PER_AXIS.pow(D as u32)
     }
 
+    /// The nodes a stencil holds while every domain fits `NARROW_PER_AXIS`, as the seed
+    /// sub-cells do until a domain stretches past a cell: the hats of the widest block's last
+    /// node along each axis are then zero over the whole domain.
+    pub fn narrow_nodes_per_point() -> usize {
+        NARROW_PER_AXIS.pow(D as u32)
+    }
+
     /// Fills every particle's stencil with S_ip and grad S_ip. CPDI2 also sets each
-    /// particle's volume to the area of its quadrilateral.
+    /// particle's volume to the area of its quadrilateral. Narrow stencils that a domain has
+    /// outgrown are widened to `nodes_per_point` and filled again; they stay wide after.
     pub fn fill(
+        &self,
+        grid: &Grid<D>,
+        particles: &mut Particles<D>,
+        stencils: &mut Stencils<D>,
+    ) -> Result<(), DomainFault> {
+        if stencils.per_point == Self::narrow_nodes_per_point() {
+            match self.fill_blocks::<NARROW_PER_AXIS>(grid, particles, stencils) {
+                Err(DomainFault::TooWide(_)) => stencils.reshape(Self::nodes_per_point()),
+                done => return done,
+            }
+        }
+        self.fill_blocks::<NODES_PER_AXIS>(grid, particles, stencils)
+    }
+
+    /// `fill` with blocks of `A` nodes per axis, which `stencils` must hold (a constant, so
+    /// that the loops over a block unroll).
+    fn fill_blocks<const A: usize>(
         &self,
         grid: &Grid<D>,
         particles: &mut Particles<D>,
@@ -148,7 +178,8 @@ impl<const D: usize> ParticleDomains<D> {
                 return Err(DomainFault::Outside(p));
             }
             if let Some(half) = self.box_half_widths(particles, p) {
-                fill_box(grid, &x, &half, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
+                fill_box::<D, A>(grid, &x, &half, node, weight, grad)
+                    .ok_or(DomainFault::TooWide(p))?;
                 continue;
             }
             self.corners_of(particles, p, corners);
@@ -156,7 +187,8 @@ impl<const D: usize> ParticleDomains<D> {
                 *corner = clamp_to_grid(grid, corner);
             }
             let cw = corner_weights(corners).ok_or(DomainFault::Inverted(p))?;
-            fill_corners(grid, corners, &cw, node, weight, grad).ok_or(DomainFault::TooWide(p))?;
+            fill_corners::<D, A>(grid, corners, &cw, node, weight, grad)
+                .ok_or(DomainFault::TooWide(p))?;
             if self.shape == DomainShape::Quadrilateral {
                 particles.volume[p] = cw.volume;
             }
@@ -224,7 +256,7 @@ fn clamp_to_grid<const D: usize>(grid: &Grid<D>, x: &SVector<f64, D>) -> SVector
 }
 
 /// GIMP: the box [x - half, x + half], cut to the grid, as a product of per-axis averages.
-fn fill_box<const D: usize>(
+fn fill_box<const D: usize, const A: usize>(
     grid: &Grid<D>,
     x: &SVector<f64, D>,
     half: &SVector<f64, D>,
@@ -240,14 +272,13 @@ fn fill_box<const D: usize>(
     let hi = SVector::<f64, D>::from_fn(|k, _| {
         (((x[k] + half[k]) - grid.lower[k]) * inv_h).clamp(0.0, cells)
     });
-    let start = block_start(grid, &lo, &hi)?;
-    let mut value = [[0.0; NODES_PER_AXIS]; D];
-    let mut slope = [[0.0; NODES_PER_AXIS]; D];
+    let start = block_start(grid, &lo, &hi, A)?;
+    let mut value = [[0.0; A]; D];
+    let mut slope = [[0.0; A]; D];
     for k in 0..D {
         averaged_hats(lo[k], hi[k], start[k], &mut value[k], &mut slope[k]);
     }
-    for e in 0..node.len() {
-        let (index, local) = block_node(grid, &start, NODES_PER_AXIS, e);
+    for_each_block_node(grid, &start, A, |e, index, local| {
         let mut w = 1.0;
         let mut g = SVector::<f64, D>::repeat(inv_h);
         for k in 0..D {
@@ -263,12 +294,12 @@ fn fill_box<const D: usize>(
         node[e] = index as u32;
         weight[e] = w;
         grad[e] = g;
-    }
+    });
     Some(())
 }
 
 /// CPDI: S_ip = sum_a w_a N_i(x_a), grad S_ip = sum_a g_a N_i(x_a) over the corners.
-fn fill_corners<const D: usize>(
+fn fill_corners<const D: usize, const A: usize>(
     grid: &Grid<D>,
     corners: &[SVector<f64, D>],
     cw: &cpdi::CornerWeights<D>,
@@ -284,19 +315,18 @@ fn fill_corners<const D: usize>(
         lo = lo.inf(&local(c));
         hi = hi.sup(&local(c));
     }
-    let start = block_start(grid, &lo, &hi)?;
+    let start = block_start(grid, &lo, &hi, A)?;
     // hats[a][k][j]: the hat of the block's j-th node along axis k at corner a.
-    let mut hats = [[[0.0; NODES_PER_AXIS]; D]; MAX_CORNERS];
+    let mut hats = [[[0.0; A]; D]; MAX_CORNERS];
     for (a, c) in corners.iter().enumerate() {
         let s = local(c);
         for k in 0..D {
-            for j in 0..NODES_PER_AXIS {
+            for j in 0..A {
                 hats[a][k][j] = hat(s[k] - (start[k] + j) as f64);
             }
         }
     }
-    for e in 0..node.len() {
-        let (index, at) = block_node(grid, &start, NODES_PER_AXIS, e);
+    for_each_block_node(grid, &start, A, |e, index, at| {
         let mut w = 0.0;
         let mut g = SVector::<f64, D>::zeros();
         for a in 0..corners.len() {
@@ -307,6 +337,6 @@ fn fill_corners<const D: usize>(
         node[e] = index as u32;
         weight[e] = w;
         grad[e] = g;
-    }
+    });
     Some(())
 }

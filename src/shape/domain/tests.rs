@@ -130,7 +130,15 @@ fn gimp_gradient_matches_finite_differences() {
                 y[k] += delta;
                 let half = SVector::repeat(domains.half0);
                 let mut s = Stencils::new(st.per_point, 1);
-                fill_box(&grid, &y, &half, &mut s.node, &mut s.weight, &mut s.grad).unwrap();
+                fill_box::<2, NODES_PER_AXIS>(
+                    &grid,
+                    &y,
+                    &half,
+                    &mut s.node,
+                    &mut s.weight,
+                    &mut s.grad,
+                )
+                .unwrap();
                 s
             };
             let (plus, minus) = (values_at(eps), values_at(-eps));
@@ -163,7 +171,8 @@ fn gimp_tends_to_the_hat() {
             .unwrap();
         let mut st = Stencils::new(ParticleDomains::<2>::nodes_per_point(), 1);
         let h = SVector::repeat(half * grid.h);
-        fill_box(&grid, &x, &h, &mut st.node, &mut st.weight, &mut st.grad).unwrap();
+        fill_box::<2, NODES_PER_AXIS>(&grid, &x, &h, &mut st.node, &mut st.weight, &mut st.grad)
+            .unwrap();
         let (mut value, mut gradient): (f64, f64) = (0.0, 0.0);
         for (i, w, g) in st.of(0) {
             let (hw, hg) = hat_st
@@ -310,4 +319,40 @@ fn faults_name_the_particle() {
         domains.fill(&grid, &mut particles, &mut st),
         Err(DomainFault::Outside(2))
     );
+}
+
+/// Narrow stencils list exactly the nonzero entries of the widest ones, in the same order, so
+/// that every sum over a stencil is the same; a domain that outgrows them widens all of them.
+#[test]
+fn narrow_stencils_hold_the_nonzero_entries_and_widen_when_outgrown() {
+    let nonzero = |st: &Stencils<2>, p: usize| {
+        st.of(p)
+            .filter(|(_, w, g)| *w != 0.0 || g.norm() != 0.0)
+            .map(|(i, w, g)| (i, w, *g))
+            .collect::<Vec<_>>()
+    };
+    for shape in SHAPES {
+        let (grid, mut particles, domains, wide) = deformed::<2>(shape, 11);
+        let narrow_len = ParticleDomains::<2>::narrow_nodes_per_point();
+        let mut narrow = Stencils::new(narrow_len, particles.len());
+        domains.fill(&grid, &mut particles, &mut narrow).unwrap();
+        assert_eq!(narrow.per_point, narrow_len, "{shape}");
+        for p in 0..particles.len() {
+            assert_eq!(nonzero(&narrow, p), nonzero(&wide, p), "{shape} p {p}");
+        }
+        if matches!(shape, DomainShape::FixedBox | DomainShape::Quadrilateral) {
+            continue; // their domains do not follow F
+        }
+        // Particle 14's domain, stretched along x to 2.05 cells, needs four nodes along x.
+        particles.f[14] = SMatrix::from_diagonal(&SVector::<f64, 2>::new(4.1, 1.0));
+        let mut wide = Stencils::new(ParticleDomains::<2>::nodes_per_point(), particles.len());
+        domains.fill(&grid, &mut particles, &mut wide).unwrap();
+        domains.fill(&grid, &mut particles, &mut narrow).unwrap();
+        assert_eq!(narrow.per_point, wide.per_point, "{shape}");
+        assert_eq!(
+            (&narrow.node, &narrow.weight, &narrow.grad),
+            (&wide.node, &wide.weight, &wide.grad),
+            "{shape}"
+        );
+    }
 }
