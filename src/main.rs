@@ -85,9 +85,13 @@ enum Command {
         /// sbatch --time of each task, e.g. 02:00:00.
         #[arg(long, value_name = "HH:MM:SS")]
         time: Option<String>,
-        /// sbatch --cpus-per-task; each task runs this many runs at a time.
+        /// sbatch --cpus-per-task; each task runs this many runs at a time, or this many divided
+        /// by THREADS.
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
         cpus_per_task: u32,
+        /// Threads inside each run of a task (`run --threads`), at most CPUS_PER_TASK.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+        threads: u32,
         /// Rerun runs whose file already exists.
         #[arg(long)]
         force: bool,
@@ -148,6 +152,7 @@ fn main() -> ExitCode {
             partition,
             time,
             cpus_per_task,
+            threads,
             force,
             wait,
             dry_run,
@@ -161,6 +166,7 @@ fn main() -> ExitCode {
                     partition,
                     time,
                     cpus_per_task: cpus_per_task as usize,
+                    threads: threads as usize,
                     force,
                     wait,
                     dry_run,

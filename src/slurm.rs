@@ -25,6 +25,8 @@ pub struct Options {
     pub partition: Option<String>,
     pub time: Option<String>,
     pub cpus_per_task: usize,
+    /// Threads inside each run (`run --threads`).
+    pub threads: usize,
     pub force: bool,
     /// Wait for the array to end and check that every run has its file.
     pub wait: bool,
@@ -48,6 +50,13 @@ pub fn submit_study(experiments: &[Experiment], options: Options) -> Result<(), 
         Some(n) => n,
         None => DEFAULT_SHARDS.min(runs).max(1),
     };
+    if options.threads > options.cpus_per_task {
+        return Err(format!(
+            "--threads {} exceeds --cpus-per-task {}: a task's runs would have fewer cores than \
+             threads; give --cpus-per-task at least {}",
+            options.threads, options.cpus_per_task, options.threads
+        ));
+    }
     let plan = Plan::new(experiments, shards);
     let out =
         std::path::absolute(&options.out).map_err(|e| format!("{}: {e}", options.out.display()))?;
@@ -76,6 +85,7 @@ pub fn submit_study(experiments: &[Experiment], options: Options) -> Result<(), 
         partition: options.partition,
         time: options.time,
         cpus_per_task: options.cpus_per_task,
+        threads: options.threads,
         force: options.force,
         notes,
     };
@@ -191,6 +201,8 @@ pub struct ArrayJob {
     /// `sbatch --time` of each task, e.g. `02:00:00`.
     pub time: Option<String>,
     pub cpus_per_task: usize,
+    /// Threads inside each run; a task runs its CPUs divided by this many runs at a time.
+    pub threads: usize,
     /// Pass `--force` to `run`: rerun runs whose file exists.
     pub force: bool,
     /// Comment lines (the shard plan), written after the directives.
@@ -248,12 +260,17 @@ impl ArrayJob {
             let _ = writeln!(s, "# {note}");
         }
         s.push_str("set -eu\n");
+        let cpus = format!("${{SLURM_CPUS_PER_TASK:-{}}}", self.cpus_per_task);
+        // sbatch options given after `--` may change the CPUs, so the task divides what it got.
+        let jobs = match self.threads {
+            1 => format!("--jobs \"{cpus}\""),
+            t => format!("--jobs \"$(( {cpus} / {t} > 0 ? {cpus} / {t} : 1 ))\" --threads {t}"),
+        };
         let _ = write!(
             s,
-            "exec {} run --shard \"${{SLURM_ARRAY_TASK_ID}}/{n}\" --out {} --jobs \"${{SLURM_CPUS_PER_TASK:-{}}}\"{}",
+            "exec {} run --shard \"${{SLURM_ARRAY_TASK_ID}}/{n}\" --out {} {jobs}{}",
             shell_quote(&self.exe.to_string_lossy()),
             shell_quote(&self.out.to_string_lossy()),
-            self.cpus_per_task,
             if self.force { " --force" } else { "" },
         );
         for file in &self.files {

@@ -322,6 +322,61 @@ fn dry_run_prints_the_array_script_and_writes_nothing() {
     );
 }
 
+/// `--threads T` gives each run of a task T threads and the task its CPUs divided by T runs
+/// at a time, at least one; more threads than CPUs per task is refused before anything is written.
+#[test]
+fn slurm_threads_divide_each_tasks_cpus() {
+    let tmp = tempfile::tempdir().unwrap();
+    let yaml = tmp.path().join("shard_a.yaml");
+    std::fs::write(&yaml, SHARD_A).unwrap();
+    let out_dir = tmp.path().join("out");
+    let slurm = |cpus: &str, threads: &str| {
+        mpmlab(&[
+            "slurm",
+            yaml.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--cpus-per-task",
+            cpus,
+            "--threads",
+            threads,
+            "--dry-run",
+        ])
+    };
+    let out = slurm("4", "2");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let script = String::from_utf8(out.stdout).unwrap();
+    let jobs =
+        "--jobs \"$(( ${SLURM_CPUS_PER_TASK:-4} / 2 > 0 ? ${SLURM_CPUS_PER_TASK:-4} / 2 : 1 ))\" \
+                --threads 2";
+    assert!(script.contains(jobs), "{script}");
+    // What bash makes of the --jobs argument for the CPUs a task may get.
+    for (cpus, jobs) in [("", "2"), ("6", "3"), ("1", "1")] {
+        let expr =
+            "echo $(( ${SLURM_CPUS_PER_TASK:-4} / 2 > 0 ? ${SLURM_CPUS_PER_TASK:-4} / 2 : 1 ))";
+        let mut bash = std::process::Command::new("bash");
+        bash.args(["-c", expr]);
+        if !cpus.is_empty() {
+            bash.env("SLURM_CPUS_PER_TASK", cpus);
+        }
+        let printed = bash.output().unwrap().stdout;
+        assert_eq!(String::from_utf8_lossy(&printed).trim(), jobs, "{cpus:?}");
+    }
+
+    let out = slurm("2", "3");
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--threads 3 exceeds --cpus-per-task 2"),
+        "{stderr}"
+    );
+    assert!(!out_dir.exists());
+}
+
 #[test]
 fn slurm_without_sbatch_says_so_and_writes_nothing() {
     let tmp = tempfile::tempdir().unwrap();
