@@ -4,7 +4,7 @@
 //! (Tran eq 16) and needs no inversion (eq 11), dropping the polynomials the data cannot
 //! support (eq 17).
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use super::basis::{monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
@@ -118,21 +118,50 @@ impl OrthogonalBasis {
 
     /// The least-squares coefficients c of sum_j c_j q_j from rhs_j = <q_j, u>:
     /// c = sum_i p_i <p_i, u>/<p_i, p_i> over the kept polynomials (the pseudo-inverse of the
-    /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j.
+    /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j. The data may be
+    /// several fields at once (`Fitted`), each solved with a scalar's arithmetic.
     #[inline]
-    pub fn solve(&self, rhs: &[f64; MAX_TERMS]) -> [f64; MAX_TERMS] {
-        let mut out = [0.0; MAX_TERMS];
+    pub fn solve<T: Fitted>(&self, rhs: &[T; MAX_TERMS]) -> [T; MAX_TERMS] {
+        let mut out = [T::splat(0.0); MAX_TERMS];
         for i in 0..self.terms {
             if !self.kept[i] {
                 continue;
             }
-            let p_i_dot_u: f64 = (0..=i).map(|j| self.coeffs[i][j] * rhs[j]).sum();
+            // From -0.0, as `Sum` for f64 starts.
+            let p_i_dot_u = (0..=i).fold(T::splat(-0.0), |sum, j| sum + rhs[j] * self.coeffs[i][j]);
             let scale = p_i_dot_u / self.norms[i];
             for j in 0..=i {
                 out[j] += scale * self.coeffs[i][j];
             }
         }
         out
+    }
+}
+
+/// Data a least-squares fit takes: a scalar, or a small matrix of them (the components of a
+/// velocity or a stress), whose entries are fitted side by side, each with the arithmetic of
+/// a scalar fit, so that one pass over the points serves every component.
+pub trait Fitted:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<f64, Output = Self>
+    + std::ops::Div<f64, Output = Self>
+    + std::ops::AddAssign
+{
+    /// Every entry `x`.
+    fn splat(x: f64) -> Self;
+}
+
+impl Fitted for f64 {
+    fn splat(x: f64) -> Self {
+        x
+    }
+}
+
+impl<const R: usize, const C: usize> Fitted for SMatrix<f64, R, C> {
+    fn splat(x: f64) -> Self {
+        SMatrix::repeat(x)
     }
 }
 

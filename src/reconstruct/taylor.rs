@@ -27,7 +27,7 @@ use std::fmt;
 use nalgebra::SVector;
 
 use super::basis::{Degree, MAX_TERMS};
-use super::solve::{add_weighted_outer, Moments, OrthogonalBasis};
+use super::solve::{add_weighted_outer, Fitted, Moments, OrthogonalBasis};
 
 /// The largest Taylor basis: the complete quadratic in 2D.
 pub const MAX_TAYLOR_TERMS: usize = MAX_TERMS;
@@ -219,27 +219,30 @@ impl<const D: usize> TaylorFit<D> {
 
     /// Coefficients a_1..a_n for `values` (one per point, order as given to `factor`). With
     /// `Conservation::Fixed`, a_1 = `mean` (= c / |Omega_e|) and the rest are the least-squares fit of
-    /// values - mean; with `Fitted`, `mean` is ignored. Entries beyond n are zero.
-    pub fn solve(&self, values: &[f64], mean: f64) -> [f64; MAX_TAYLOR_TERMS] {
+    /// values - mean; with `Fitted`, `mean` is ignored. Entries beyond n are zero. The values may
+    /// be the components of a vector or tensor, fitted together entry by entry.
+    pub fn solve<T: Fitted>(&self, values: &[T], mean: T) -> [T; MAX_TAYLOR_TERMS] {
         assert_eq!(
             values.len(),
             self.psi.len(),
             "one value per point of the factorisation"
         );
+        let zero = T::splat(0.0);
         let first = self.prescribed;
         let fitted = self.terms - first;
-        let shift = if first == 1 { mean } else { 0.0 };
+        let shift = if first == 1 { mean } else { zero };
         // A solve, then one refinement with its residual (module notes): the correction
         // converges because kappa^2 eps <= 1e-6 wherever the rank test passed.
-        let mut c = [0.0; MAX_TERMS];
+        let mut c = [zero; MAX_TERMS];
         for _ in 0..2 {
             // <psi_j, u - shift - sum_k c_k psi_k> over the data, point by point in order.
-            let mut rhs = [0.0; MAX_TERMS];
+            let mut rhs = [zero; MAX_TERMS];
             for (psi, &u) in self.psi.iter().zip(values) {
-                let fit: f64 = (0..fitted).map(|k| c[k] * psi[first + k]).sum();
+                // From -0.0, as `Sum` for f64 starts.
+                let fit = (0..fitted).fold(T::splat(-0.0), |sum, k| sum + c[k] * psi[first + k]);
                 let r = u - shift - fit;
                 for j in 0..fitted {
-                    rhs[j] += psi[first + j] * r;
+                    rhs[j] += r * psi[first + j];
                 }
             }
             let correction = self.basis.solve(&rhs);
@@ -247,7 +250,7 @@ impl<const D: usize> TaylorFit<D> {
                 c[j] += correction[j];
             }
         }
-        let mut a = [0.0; MAX_TAYLOR_TERMS];
+        let mut a = [zero; MAX_TAYLOR_TERMS];
         if first == 1 {
             a[0] = mean;
         }

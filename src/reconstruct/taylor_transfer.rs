@@ -49,7 +49,9 @@ pub struct TaylorTransfer<const D: usize> {
     /// Positions and densities of the sorted particles at the mapping, kept for the remap.
     points: Vec<SVector<f64, D>>,
     density: Vec<f64>,
-    values: Vec<f64>,
+    /// Scratch: the momentum densities and stresses of one element's particles.
+    vectors: Vec<SVector<f64, D>>,
+    tensors: Vec<SMatrix<f64, D, D>>,
     /// Per element, the fit with the element's mass and momentum prescribed, factorised at the
     /// mapping and reused by the remap, which fits the same points.
     prescribed: Vec<TaylorFit<D>>,
@@ -107,7 +109,8 @@ impl<const D: usize> TaylorTransfer<D> {
             order: Vec::new(),
             points: Vec::new(),
             density: Vec::new(),
-            values: Vec::new(),
+            vectors: Vec::new(),
+            tensors: Vec::new(),
             prescribed: (0..elements).map(|_| TaylorFit::default()).collect(),
             fitted: TaylorFit::default(),
             mass_solver: MassSolver::new(recipe.mass, num_dofs, fixed),
@@ -254,47 +257,30 @@ impl<const D: usize> TaylorTransfer<D> {
         mass: &[f64],
     ) -> [SVector<f64, D>; MAX_TAYLOR_TERMS] {
         let (start, end) = self.range(e);
-        let mut coefficients = [SVector::zeros(); MAX_TAYLOR_TERMS];
-        for k in 0..D {
-            self.values.clear();
-            let mut momentum = 0.0;
-            for (&p, &rho) in self.order[start..end].iter().zip(&self.density[start..end]) {
-                let p = p as usize;
-                self.values.push(rho * v[p][k]);
-                momentum += mass[p] * v[p][k];
-            }
-            let a = self.prescribed[e].solve(&self.values, momentum / cell.volume());
-            for (c, a) in coefficients.iter_mut().zip(a) {
-                c[k] = a;
-            }
+        self.vectors.clear();
+        let mut momentum = SVector::zeros();
+        for (&p, &rho) in self.order[start..end].iter().zip(&self.density[start..end]) {
+            let p = p as usize;
+            self.vectors.push(v[p] * rho);
+            momentum += v[p] * mass[p];
         }
-        coefficients
+        self.prescribed[e].solve(&self.vectors, momentum / cell.volume())
     }
 
     /// Taylor coefficients of the stress by plain least squares; `fitted` must be factorised.
+    /// Each component sigma_rs, r <= s, is fitted once and stands for sigma_sr as well.
     fn stress(
         &mut self,
         start: usize,
         end: usize,
         stress: &[SMatrix<f64, D, D>],
     ) -> [SMatrix<f64, D, D>; MAX_TAYLOR_TERMS] {
-        let mut coefficients = [SMatrix::zeros(); MAX_TAYLOR_TERMS];
-        for r in 0..D {
-            for s in r..D {
-                self.values.clear();
-                self.values.extend(
-                    self.order[start..end]
-                        .iter()
-                        .map(|&p| stress[p as usize][(r, s)]),
-                );
-                let a = self.fitted.solve(&self.values, 0.0);
-                for (c, a) in coefficients.iter_mut().zip(a) {
-                    c[(r, s)] = a;
-                    c[(s, r)] = a;
-                }
-            }
-        }
-        coefficients
+        self.tensors.clear();
+        self.tensors.extend(self.order[start..end].iter().map(|&p| {
+            let sigma = &stress[p as usize];
+            SMatrix::from_fn(|r, s| sigma[(r.min(s), r.max(s))])
+        }));
+        self.fitted.solve(&self.tensors, SMatrix::zeros())
     }
 
     /// Element `e`'s box.

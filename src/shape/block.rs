@@ -77,25 +77,26 @@ pub fn block_node<const D: usize>(
     (index, local)
 }
 
-/// Calls `visit(e, index, local)` for the entries `e = 0, 1, ...` of a block of `per_axis` nodes
-/// per axis starting at `start`: what `block_node` gives for each, counted up axis by axis
-/// instead of divided out, as the per-particle stencils need it for every entry.
+/// Calls `visit(e, index, local)` for the entries `e = 0, 1, ...` of a block of `A` nodes per
+/// axis starting at `start`: what `block_node` gives for each, from per-axis tables of the
+/// nodes' index terms and counted up axis by axis instead of divided out, as the per-particle
+/// stencils need it for every entry.
 #[inline]
-pub fn for_each_block_node<const D: usize>(
+pub fn for_each_block_node<const D: usize, const A: usize>(
     grid: &Grid<D>,
     start: &[usize; D],
-    per_axis: usize,
     mut visit: impl FnMut(usize, usize, &[usize; D]),
 ) {
+    let along: [[usize; A]; D] = std::array::from_fn(|k| {
+        std::array::from_fn(|l| (start[k] + l).min(grid.cells) * grid.stride(k))
+    });
     let mut local = [0; D];
-    for e in 0..per_axis.pow(D as u32) {
-        let index = (0..D)
-            .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
-            .sum();
+    for e in 0..A.pow(D as u32) {
+        let index = (0..D).map(|k| along[k][local[k]]).sum();
         visit(e, index, &local);
         for k in 0..D {
             local[k] += 1;
-            if local[k] < per_axis {
+            if local[k] < A {
                 break;
             }
             local[k] = 0;

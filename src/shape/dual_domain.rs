@@ -7,7 +7,7 @@
 
 use nalgebra::SVector;
 
-use super::block::{block_around_cell, block_node, NODES_PER_AXIS};
+use super::block::{block_around_cell, for_each_block_node, NODES_PER_AXIS};
 use super::{lattice_coords, Dofs, Grid, LinearHat, Shape};
 
 /// Offsets i - j per axis of the nodes i whose hat overlaps that of node j: -1, 0, 1.
@@ -15,6 +15,37 @@ const NEIGHBOURS_PER_AXIS: usize = 3;
 
 /// Hat corners of a cell in at most two dimensions.
 const MAX_CORNERS: usize = 4;
+
+/// Offsets i - j in at most two dimensions.
+const MAX_NEIGHBOURS: usize = NEIGHBOURS_PER_AXIS * NEIGHBOURS_PER_AXIS;
+
+/// Nodes per axis of the block that `eval` sums the gradient into: the stencil block and one
+/// node beyond it on each side. An offset to a node off the grid, whose average is zero, lands
+/// outside the stencil block (or on an entry past a grid of under three cells, which carries
+/// zero), so the sums need no test for the grid's ends.
+const PADDED_PER_AXIS: usize = NODES_PER_AXIS + 2;
+
+/// Nodes of the padded block in at most two dimensions.
+const MAX_PADDED: usize = PADDED_PER_AXIS * PADDED_PER_AXIS;
+
+/// Flat-index places per axis (first axis fastest) of the padded block.
+const PADDED_PLACE: [usize; 2] = [1, PADDED_PER_AXIS];
+
+/// The offsets i - j in {-1, 0, 1}^D (first axis fastest) as steps in the padded block.
+const fn padded_steps<const D: usize>() -> [usize; MAX_NEIGHBOURS] {
+    let mut steps = [0; MAX_NEIGHBOURS];
+    let mut offset = 0;
+    while offset < NEIGHBOURS_PER_AXIS.pow(D as u32) {
+        let (mut rest, mut k) = (offset, 0);
+        while k < D {
+            steps[offset] += rest % NEIGHBOURS_PER_AXIS * PADDED_PLACE[k];
+            rest /= NEIGHBOURS_PER_AXIS;
+            k += 1;
+        }
+        offset += 1;
+    }
+    steps
+}
 
 /// How the integrals over the material are taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -208,62 +239,49 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
     ) -> bool {
-        let corners = 1 << D;
-        let mut hat_node = [0u32; MAX_CORNERS];
-        let mut hat = [0.0; MAX_CORNERS];
-        let mut hat_grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
-        let Some((cell, _)) = grid.locate(x) else {
+        let Some((cell, xi)) = grid.locate(x) else {
             return false;
         };
-        if !LinearHat.eval(
-            grid,
-            x,
-            &mut hat_node[..corners],
-            &mut hat[..corners],
-            &mut hat_grad[..corners],
-        ) {
-            return false;
-        }
         let start = block_around_cell(grid, &cell);
-        for e in 0..node.len() {
-            node[e] = block_node(grid, &start, NODES_PER_AXIS, e).0 as u32;
-        }
-        weight.fill(0.0);
-        grad.fill(SVector::zeros());
         let stride = DualDomain::<D>::neighbours();
-        for b in 0..corners {
-            let j = hat_node[b] as usize;
-            let corner: [usize; D] = std::array::from_fn(|k| cell[k] + (b >> k & 1));
-            weight[block_entry(&start, &corner)] = hat[b];
-            'offsets: for offset in 0..stride {
-                let mut target = corner;
-                let mut rest = offset;
-                for t in target.iter_mut() {
-                    let d = rest % NEIGHBOURS_PER_AXIS;
-                    rest /= NEIGHBOURS_PER_AXIS;
-                    // Node j - 1 does not exist at the lower end, j + 1 not at the upper.
-                    if *t + d < 1 || *t + d > grid.cells + 1 {
-                        continue 'offsets;
-                    }
-                    *t = *t + d - 1;
-                }
-                grad[block_entry(&start, &target)] += self.average[j * stride + offset] * hat[b];
+        weight.fill(0.0);
+        let mut padded = [SVector::<f64, D>::zeros(); MAX_PADDED];
+        let base = grid.node_index(cell);
+        for b in 0..1 << D {
+            // The hat of corner j = b of the cell, as `LinearHat` evaluates it.
+            let mut hat = 1.0;
+            let mut j = base;
+            let mut entry = 0;
+            let mut place = 1;
+            // The padded entry of node j - 1 per axis.
+            let mut lowest = 0;
+            let mut padded_place = 1;
+            for k in 0..D {
+                let upper = b >> k & 1;
+                hat *= if upper == 1 { xi[k] } else { 1.0 - xi[k] };
+                j += upper * grid.stride(k);
+                let local = cell[k] + upper - start[k];
+                entry += local * place;
+                lowest += local * padded_place;
+                place *= NODES_PER_AXIS;
+                padded_place *= PADDED_PER_AXIS;
+            }
+            weight[entry] = hat;
+            for (average, step) in self.average[j * stride..(j + 1) * stride]
+                .iter()
+                .zip(&const { padded_steps::<D>() })
+            {
+                padded[lowest + step] += average * hat;
             }
         }
+        for_each_block_node::<D, NODES_PER_AXIS>(grid, &start, |e, index, local| {
+            node[e] = index as u32;
+            grad[e] = padded[(0..D)
+                .map(|k| (local[k] + 1) * PADDED_PLACE[k])
+                .sum::<usize>()];
+        });
         true
     }
-}
-
-/// Entry of node `ijk` in the block starting at `start` (first axis fastest).
-#[inline]
-fn block_entry<const D: usize>(start: &[usize; D], ijk: &[usize; D]) -> usize {
-    let mut entry = 0;
-    let mut place = 1;
-    for k in 0..D {
-        entry += (ijk[k] - start[k]) * place;
-        place *= NODES_PER_AXIS;
-    }
-    entry
 }
 
 #[cfg(test)]

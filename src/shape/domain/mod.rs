@@ -278,7 +278,7 @@ fn fill_box<const D: usize, const A: usize>(
     for k in 0..D {
         averaged_hats(lo[k], hi[k], start[k], &mut value[k], &mut slope[k]);
     }
-    for_each_block_node(grid, &start, A, |e, index, local| {
+    for_each_block_node::<D, A>(grid, &start, |e, index, local| {
         let mut w = 1.0;
         let mut g = SVector::<f64, D>::repeat(inv_h);
         for k in 0..D {
@@ -326,7 +326,7 @@ fn fill_corners<const D: usize, const A: usize>(
             }
         }
     }
-    for_each_block_node(grid, &start, A, |e, index, at| {
+    for_each_block_node::<D, A>(grid, &start, |e, index, at| {
         let mut w = 0.0;
         let mut g = SVector::<f64, D>::zeros();
         for a in 0..corners.len() {
