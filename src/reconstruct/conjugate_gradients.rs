@@ -1,13 +1,14 @@
 //! Preconditioned conjugate gradients for a consistent mass matrix restricted to a set of
-//! DOFs, with the lumped mass as the preconditioner. For a basis that is nonnegative and a
-//! partition of unity the lumped matrix bounds the consistent one from above,
-//! x^T M x <= x^T M_L x (Cauchy-Schwarz on sum_i N_i x_i), and stays within a small factor of
-//! it from below on a mesh the material covers, so the iteration count does not grow with
-//! the mesh, while a direct band factorisation costs a grid row squared per DOF.
+//! DOFs, with the lumped mass (here) or the line sums (`line_sums.rs`) as the preconditioner.
+//! For a basis that is nonnegative and a partition of unity the lumped matrix bounds the
+//! consistent one from above, x^T M x <= x^T M_L x (Cauchy-Schwarz on sum_i N_i x_i), and
+//! stays within a small factor of it from below on a mesh the material covers, so the
+//! iteration count does not grow with the mesh, while a direct band factorisation costs a
+//! grid row squared per DOF.
 
 use super::diagonals::SymmetricDiagonals;
 
-/// The solve stops when the preconditioned residual r^T M_L^-1 r has fallen by this factor
+/// The solve stops when the preconditioned residual r^T P^-1 r has fallen by this factor
 /// squared: about the accuracy of a direct factorisation of these well-conditioned
 /// matrices, so that the change from one is round-off (docs/NOTES.md).
 pub const RELATIVE_RESIDUAL: f64 = 1e-14;
@@ -35,12 +36,13 @@ pub struct ConjugateGradients {
 }
 
 impl ConjugateGradients {
-    /// Solves M x = b on the DOFs where `inverse_lumped` is positive, x zero elsewhere; `b`
-    /// is overwritten with x. Returns the iterations taken.
+    /// Solves M x = b on the DOFs where the preconditioner `precondition(r, z)` (z = P^-1 r,
+    /// symmetric and positive definite there) is nonzero, x zero elsewhere; `b` is
+    /// overwritten with x. Returns the iterations taken.
     pub fn solve(
         &mut self,
         matrix: &SymmetricDiagonals,
-        inverse_lumped: &[f64],
+        mut precondition: impl FnMut(&[f64], &mut [f64]),
         b: &mut [f64],
     ) -> Result<usize, Breakdown> {
         let n = matrix.order();
@@ -56,7 +58,7 @@ impl ConjugateGradients {
         }
         // Entries off the DOFs never enter: z and so p, x are zero there.
         self.r.copy_from_slice(&b[..n]);
-        precondition(inverse_lumped, &self.r, &mut self.z);
+        precondition(&self.r, &mut self.z);
         self.p.copy_from_slice(&self.z);
         let mut rz = dot(&self.r, &self.z);
         if !rz.is_finite() {
@@ -81,7 +83,7 @@ impl ConjugateGradients {
                 self.x[i] += alpha * self.p[i];
                 self.r[i] -= alpha * self.q[i];
             }
-            precondition(inverse_lumped, &self.r, &mut self.z);
+            precondition(&self.r, &mut self.z);
             let rz_new = dot(&self.r, &self.z);
             if !rz_new.is_finite() {
                 return Err(Breakdown::NotConverged(rz_new));
@@ -97,7 +99,8 @@ impl ConjugateGradients {
     }
 }
 
-fn precondition(inverse_lumped: &[f64], r: &[f64], z: &mut [f64]) {
+/// The lumped preconditioner: z = M_L^-1 r with `inverse_lumped` zero off the DOFs.
+pub fn precondition_lumped(inverse_lumped: &[f64], r: &[f64], z: &mut [f64]) {
     for ((z, &r), &w) in z.iter_mut().zip(r).zip(inverse_lumped) {
         *z = r * w;
     }
@@ -151,7 +154,7 @@ mod tests {
         let b: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).sin() + 0.5).collect();
         let mut x = b.clone();
         let iterations = ConjugateGradients::default()
-            .solve(&matrix, &inverse, &mut x)
+            .solve(&matrix, |r, z| precondition_lumped(&inverse, r, z), &mut x)
             .unwrap();
         assert!(iterations < 40, "{iterations} iterations");
         let index: Vec<usize> = (0..n).filter(|&i| kept[i]).collect();
@@ -171,7 +174,11 @@ mod tests {
         let (matrix, lumped) = hat_mass(5);
         let inverse: Vec<f64> = lumped.iter().map(|m| 1.0 / m).collect();
         let mut x = vec![0.0; 5];
-        let iterations = ConjugateGradients::default().solve(&matrix, &inverse, &mut x);
+        let iterations = ConjugateGradients::default().solve(
+            &matrix,
+            |r, z| precondition_lumped(&inverse, r, z),
+            &mut x,
+        );
         assert_eq!(iterations, Ok(0));
     }
 
@@ -182,13 +189,21 @@ mod tests {
         matrix.add(0, 0, 1.0);
         matrix.add(1, 1, -1.0);
         let mut x = vec![0.0, 1.0];
-        let result = ConjugateGradients::default().solve(&matrix, &[1.0, 1.0], &mut x);
+        let result = ConjugateGradients::default().solve(
+            &matrix,
+            |r, z| precondition_lumped(&[1.0, 1.0], r, z),
+            &mut x,
+        );
         assert!(
             matches!(result, Err(Breakdown::NotPositiveDefinite(_))),
             "{result:?}"
         );
         let mut x = vec![f64::NAN, 1.0];
-        let result = ConjugateGradients::default().solve(&matrix, &[1.0, 1.0], &mut x);
+        let result = ConjugateGradients::default().solve(
+            &matrix,
+            |r, z| precondition_lumped(&[1.0, 1.0], r, z),
+            &mut x,
+        );
         assert!(
             matches!(result, Err(Breakdown::NotConverged(_))),
             "{result:?}"

@@ -19,9 +19,10 @@ pub struct ConsistentMassTransfer<const D: usize> {
 }
 
 impl<const D: usize> ConsistentMassTransfer<D> {
-    pub fn new(num_dofs: usize, fixed: &[FixedDof]) -> Self {
+    /// A transfer on a lattice of `dofs_per_axis` DOFs per axis.
+    pub fn new(dofs_per_axis: usize, fixed: &[FixedDof]) -> Self {
         ConsistentMassTransfer {
-            solver: MassSolver::new(MassMatrix::Consistent, num_dofs, fixed),
+            solver: MassSolver::new(MassMatrix::Consistent, dofs_per_axis, fixed),
         }
     }
 
@@ -38,7 +39,7 @@ impl<const D: usize> ConsistentMassTransfer<D> {
         self.solver.reset(stencils.bandwidth());
         for p in 0..particles.len() {
             let m = particles.mass[p];
-            for (i, n_i, _) in stencils.of(p) {
+            for (i, n_i, _) in stencils.of(p).filter(|&(_, n_i, _)| n_i != 0.0) {
                 for (j, n_j, _) in stencils.of(p).filter(|&(j, _, _)| j <= i) {
                     self.solver.add(i, j, m * n_i * n_j);
                 }
@@ -135,7 +136,7 @@ mod tests {
         let mut lumped = GridState::new(grid.num_nodes(), 1.0);
         crate::reconstruct::particles_to_grid(&stencils, &particles, &body, &mut lumped);
         let mut consistent = GridState::new(grid.num_nodes(), 1.0);
-        let mut transfer = ConsistentMassTransfer::new(grid.num_nodes(), &[]);
+        let mut transfer = ConsistentMassTransfer::new(grid.nodes_per_dim(), &[]);
         transfer
             .map_to_grid(&stencils, &particles, &body, &mut consistent)
             .unwrap();
@@ -240,7 +241,7 @@ mod tests {
             .unwrap();
         let body = vec![SVector::zeros(); particles.len()];
         let mut nodes = GridState::new(grid.num_nodes(), 1.0);
-        let mut transfer = ConsistentMassTransfer::new(grid.num_nodes(), &[]);
+        let mut transfer = ConsistentMassTransfer::new(grid.nodes_per_dim(), &[]);
         transfer
             .map_to_grid(&stencils, &particles, &body, &mut nodes)
             .unwrap();
@@ -285,7 +286,8 @@ mod tests {
             }
             let last = (grid.num_nodes() - 1) as u32;
             let mut nodes = GridState::new(grid.num_nodes(), 1.0 / n as f64);
-            let mut transfer = ConsistentMassTransfer::new(grid.num_nodes(), &[(0, 0), (last, 0)]);
+            let mut transfer =
+                ConsistentMassTransfer::new(grid.nodes_per_dim(), &[(0, 0), (last, 0)]);
             let body = vec![SVector::zeros(); n];
             transfer
                 .map_to_grid(&stencils, &particles, &body, &mut nodes)
@@ -316,13 +318,13 @@ mod tests {
 
     /// On a 2D grid of 32 cells the band is a grid row wide and the solve iterates: the
     /// projection of v = (1 + 2x - y, 3 - x + 4y) from jittered particles of random mass is
-    /// still exact at every DOF that carries mass.
-    #[test]
-    fn the_iterative_solve_reproduces_linear_fields_in_2d() {
+    /// still exact at every DOF that carries mass, with the lumped preconditioner (the hat)
+    /// and with the line sums (the quadratic B-spline).
+    fn check_iterative_solve_2d<S: Shape<2>>(shape: &S, dofs: Dofs, with_lines: bool) {
         use crate::benchmarks::Problem;
         let prob = crate::benchmarks::gong_mms::<2>(&crate::benchmarks::thesis_params(1e-4, 32, 2))
             .unwrap();
-        let grid = Grid::new(&prob.domain());
+        let grid = Grid::with_dofs(&prob.domain(), dofs);
         let mut particles = Particles::seed(&prob, &grid);
         let mut rng = crate::rng::Lcg::new(5);
         let field = |x: &SVector<f64, 2>| {
@@ -334,14 +336,9 @@ mod tests {
             particles.mass[p] *= 0.5 + rng.unit();
             particles.v[p] = field(&particles.x[p]);
         }
-        let mut stencils = Stencils::new(
-            Shape::<2>::nodes_per_point(&crate::shape::LinearHat),
-            particles.len(),
-        );
-        stencils
-            .update(&crate::shape::LinearHat, &grid, &particles.x)
-            .unwrap();
-        let mut transfer = ConsistentMassTransfer::new(grid.num_nodes(), &[]);
+        let mut stencils = Stencils::new(shape.nodes_per_point(), particles.len());
+        stencils.update(shape, &grid, &particles.x).unwrap();
+        let mut transfer = ConsistentMassTransfer::new(grid.nodes_per_dim(), &[]);
         let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
         let body = vec![SVector::zeros(); particles.len()];
         transfer
@@ -351,6 +348,7 @@ mod tests {
             !transfer.solver.is_direct(),
             "the 2D band should be iterated"
         );
+        assert_eq!(transfer.solver.uses_line_sums(), with_lines);
         let mut checked = 0;
         for i in 0..grid.num_nodes() {
             let want = field(&grid.node_position(i));
@@ -365,6 +363,13 @@ mod tests {
                 }
             }
         }
-        assert!(checked > 2 * 33 * 33 - 10);
+        let per_axis = grid.nodes_per_dim();
+        assert!(checked > 2 * per_axis * per_axis - 10);
+    }
+
+    #[test]
+    fn the_iterative_solve_reproduces_linear_fields_in_2d() {
+        check_iterative_solve_2d(&crate::shape::LinearHat, Dofs::Nodes, false);
+        check_iterative_solve_2d(&QuadraticBSpline, Dofs::QuadraticSpline, true);
     }
 }

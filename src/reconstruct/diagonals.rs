@@ -39,6 +39,11 @@ impl SymmetricDiagonals {
         self.distances.iter().copied().max().unwrap_or(0)
     }
 
+    /// The distances d = i - j of the stored diagonals, in the order they were first given.
+    pub fn distances(&self) -> &[usize] {
+        &self.distances
+    }
+
     /// Stored entries per row: the main diagonal and each off-diagonal on both sides.
     pub fn entries_per_row(&self) -> usize {
         self.distances
@@ -68,6 +73,15 @@ impl SymmetricDiagonals {
         match self.slot.get(d) {
             Some(&s) if s != UNUSED => self.values[s as usize * self.n + row],
             _ => 0.0,
+        }
+    }
+
+    /// Calls `visit(i, j, a_ij)` for every stored entry of the lower triangle (j <= i).
+    pub fn for_each_lower(&self, mut visit: impl FnMut(usize, usize, f64)) {
+        for (s, &d) in self.distances.iter().enumerate() {
+            for i in d..self.n {
+                visit(i, i - d, self.values[s * self.n + i]);
+            }
         }
     }
 

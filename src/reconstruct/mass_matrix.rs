@@ -5,8 +5,11 @@
 use nalgebra::SVector;
 
 use super::banded::BandMatrix;
-use super::conjugate_gradients::{Breakdown, ConjugateGradients, MAX_ITERATIONS};
+use super::conjugate_gradients::{
+    precondition_lumped, Breakdown, ConjugateGradients, MAX_ITERATIONS,
+};
 use super::diagonals::SymmetricDiagonals;
+use super::line_sums::LineSums;
 use super::GridState;
 use crate::integrate::{Divergence, FixedDof};
 
@@ -46,6 +49,12 @@ pub struct MassSolver<const D: usize> {
     factor_of: [usize; D],
     /// Iterative: per component 1 / m_i on its DOFs, zero elsewhere.
     inverse_lumped: Vec<Vec<f64>>,
+    /// DOFs per axis of the lattice.
+    per_axis: usize,
+    /// Iterative in 2D: per component the line-sum preconditioner on its DOFs, used where it
+    /// factorised (`with_lines`); the lumped one otherwise.
+    lines: Vec<LineSums>,
+    with_lines: [bool; D],
     iterations: ConjugateGradients,
     rhs: Vec<f64>,
     /// sum_i p_i of the last `solve_momenta`: the momentum the DOFs received.
@@ -53,7 +62,9 @@ pub struct MassSolver<const D: usize> {
 }
 
 impl<const D: usize> MassSolver<D> {
-    pub fn new(kind: MassMatrix, num_dofs: usize, fixed: &[FixedDof]) -> Self {
+    /// A solver on a lattice of `per_axis` DOFs per axis.
+    pub fn new(kind: MassMatrix, per_axis: usize, fixed: &[FixedDof]) -> Self {
+        let num_dofs = per_axis.pow(D as u32);
         let mut mask = vec![[false; D]; num_dofs];
         for &(i, k) in fixed {
             mask[i as usize][k as usize] = true;
@@ -67,6 +78,9 @@ impl<const D: usize> MassSolver<D> {
             free: vec![Vec::new(); D],
             factor_of: std::array::from_fn(|k| k),
             inverse_lumped: vec![Vec::new(); D],
+            per_axis,
+            lines: vec![LineSums::default(); D],
+            with_lines: [false; D],
             iterations: ConjugateGradients::default(),
             rhs: Vec::new(),
             received: SVector::zeros(),
@@ -83,21 +97,31 @@ impl<const D: usize> MassSolver<D> {
         self.direct
     }
 
+    /// Whether the last `prepare` gave every component the line-sum preconditioner.
+    #[cfg(test)]
+    pub(crate) fn uses_line_sums(&self) -> bool {
+        self.with_lines.iter().all(|&lines| lines)
+    }
+
     /// Starts a new consistent matrix whose entries lie at most `bandwidth` off the diagonal
     /// (the largest DOF distance within one point's stencil).
     pub fn reset(&mut self, bandwidth: usize) {
         self.matrix.reset(self.fixed.len(), bandwidth);
     }
 
-    /// Adds `value` to M_ij and M_ji.
+    /// Adds `value` to M_ij and M_ji. A zero is not stored: the block stencils list nodes
+    /// their point does not reach (the dual-domain gradient's, the particle domains'), whose
+    /// zeros would widen the matrix's pattern and every product with it.
     #[inline]
     pub fn add(&mut self, i: usize, j: usize, value: f64) {
-        self.matrix.add(i, j, value);
+        if value != 0.0 {
+            self.matrix.add(i, j, value);
+        }
     }
 
     /// Prepares the solves with the assembled matrix on, per component, the DOFs whose lumped
     /// mass `mass` exceeds `empty_mass` and that are free in that component: the factors, or
-    /// the preconditioner of the conjugate gradients.
+    /// the preconditioners of the conjugate gradients.
     pub fn prepare(&mut self, mass: &[f64], empty_mass: f64) -> Result<(), Divergence> {
         let bandwidth = self.matrix.bandwidth();
         self.direct = bandwidth * bandwidth <= DIRECT_SOLVE_RATIO * self.matrix.entries_per_row();
@@ -114,6 +138,15 @@ impl<const D: usize> MassSolver<D> {
                     0.0
                 }
             }));
+        }
+        for k in 0..D {
+            let inverse = &self.inverse_lumped[k];
+            // A line sum that is not positive definite (a matrix far from a product of 1D
+            // ones) leaves the component with the lumped preconditioner.
+            self.with_lines[k] = D == 2
+                && self.lines[k]
+                    .prepare(&self.matrix, self.per_axis, |i| inverse[i] > 0.0)
+                    .unwrap_or(false);
         }
         Ok(())
     }
@@ -218,9 +251,19 @@ impl<const D: usize> MassSolver<D> {
                 }
             } else {
                 rhs.extend(field.iter().map(|x| x[k]));
-                self.iterations
-                    .solve(&self.matrix, &self.inverse_lumped[k], rhs)
-                    .map_err(breakdown_message)?;
+                let solved = if self.with_lines[k] {
+                    let lines = &mut self.lines[k];
+                    self.iterations
+                        .solve(&self.matrix, |r, z| lines.apply(r, z), rhs)
+                } else {
+                    let inverse = &self.inverse_lumped[k];
+                    self.iterations.solve(
+                        &self.matrix,
+                        |r, z| precondition_lumped(inverse, r, z),
+                        rhs,
+                    )
+                };
+                solved.map_err(breakdown_message)?;
                 for (x, &value) in field.iter_mut().zip(rhs.iter()) {
                     x[k] = value;
                 }

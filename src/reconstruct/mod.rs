@@ -11,6 +11,7 @@ mod gauss;
 mod kernel;
 mod lattice;
 mod least_squares;
+mod line_sums;
 mod mass_matrix;
 mod quadrature;
 mod shepard;

@@ -69,7 +69,6 @@ impl<const D: usize> TaylorTransfer<D> {
         shape: &S,
         fixed: &[FixedDof],
     ) -> Self {
-        let num_dofs = grid.num_nodes();
         let (abscissae, weights) = gauss_legendre_rule(recipe.gauss_points);
         let n = recipe.gauss_points;
         let per_element = n.pow(D as u32);
@@ -113,7 +112,7 @@ impl<const D: usize> TaylorTransfer<D> {
             tensors: Vec::new(),
             prescribed: (0..elements).map(|_| TaylorFit::default()).collect(),
             fitted: TaylorFit::default(),
-            mass_solver: MassSolver::new(recipe.mass, num_dofs, fixed),
+            mass_solver: MassSolver::new(recipe.mass, grid.nodes_per_dim(), fixed),
         }
     }
 
@@ -180,7 +179,7 @@ impl<const D: usize> TaylorTransfer<D> {
                     grid.mass[i] += rho_g * n_i;
                     grid.velocity[i] += rho_v_g * n_i;
                     grid.force[i] -= sigma_g * grad;
-                    if consistent {
+                    if consistent && n_i != 0.0 {
                         for (j, n_j, _) in self.basis.of(g).filter(|&(j, _, _)| j <= i) {
                             self.mass_solver.add(i, j, rho_g * n_i * n_j);
                         }

@@ -34,7 +34,7 @@ impl<const D: usize> Transfer<D> {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
             TransferKind::ConsistentMass => Transfer::ConsistentMass(Box::new(
-                ConsistentMassTransfer::new(grid.num_nodes(), fixed),
+                ConsistentMassTransfer::new(grid.nodes_per_dim(), fixed),
             )),
             TransferKind::Quadrature(recipe) => {
                 Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid)))
