@@ -63,15 +63,20 @@ impl<const D: usize> Shape<D> for QuadraticBSpline {
         // B_c is DOF c along each axis: the cell's index is that of its first B-spline.
         let base = grid.node_index(cell);
         let inv_h = grid.inv_h();
-        for e in 0..node.len() {
+        let along: [[usize; PER_AXIS]; D] =
+            std::array::from_fn(|k| std::array::from_fn(|l| l * grid.stride(k)));
+        // A constant count, slices cut to it and the local coordinates counted up, so that
+        // the entries unroll without bounds checks.
+        let count = PER_AXIS.pow(D as u32);
+        let (node, weight, grad) = (&mut node[..count], &mut weight[..count], &mut grad[..count]);
+        let mut locals = [0; D];
+        for e in 0..count {
             let mut index = base;
-            let mut rest = e;
             let mut w = 1.0;
             let mut g = SVector::<f64, D>::repeat(inv_h);
             for k in 0..D {
-                let local = rest % PER_AXIS;
-                rest /= PER_AXIS;
-                index += local * grid.stride(k);
+                let local = locals[k];
+                index += along[k][local];
                 w *= value[k][local];
                 for l in 0..D {
                     g[l] *= if l == k {
@@ -84,6 +89,13 @@ impl<const D: usize> Shape<D> for QuadraticBSpline {
             node[e] = index as u32;
             weight[e] = w;
             grad[e] = g;
+            for local in &mut locals {
+                *local += 1;
+                if *local < PER_AXIS {
+                    break;
+                }
+                *local = 0;
+            }
         }
         true
     }
