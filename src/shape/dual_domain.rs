@@ -47,6 +47,26 @@ const fn padded_steps<const D: usize>() -> [usize; MAX_NEIGHBOURS] {
     steps
 }
 
+/// Stencil entries in at most two dimensions.
+const MAX_STENCIL: usize = NODES_PER_AXIS * NODES_PER_AXIS;
+
+/// The padded-block index of each stencil entry (first axis fastest): the block one node in
+/// from the padding on each side.
+const fn stencil_in_padded<const D: usize>() -> [usize; MAX_STENCIL] {
+    let mut index = [0; MAX_STENCIL];
+    let mut e = 0;
+    while e < NODES_PER_AXIS.pow(D as u32) {
+        let (mut rest, mut k) = (e, 0);
+        while k < D {
+            index[e] += (rest % NODES_PER_AXIS + 1) * PADDED_PLACE[k];
+            rest /= NODES_PER_AXIS;
+            k += 1;
+        }
+        e += 1;
+    }
+    index
+}
+
 /// How the integrals over the material are taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DualIntegrals {
@@ -274,11 +294,14 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
                 padded[lowest + step] += average * hat;
             }
         }
-        for_each_block_node::<D, NODES_PER_AXIS>(grid, &start, |e, index, local| {
+        // Slices cut to the entry count and a constant table of padded places, so that the
+        // copy needs no bounds checks.
+        let count = Self::stencil_nodes();
+        let (node, grad) = (&mut node[..count], &mut grad[..count]);
+        let in_padded = const { stencil_in_padded::<D>() };
+        for_each_block_node::<D, NODES_PER_AXIS>(grid, &start, |e, index, _| {
             node[e] = index as u32;
-            grad[e] = padded[(0..D)
-                .map(|k| (local[k] + 1) * PADDED_PLACE[k])
-                .sum::<usize>()];
+            grad[e] = padded[in_padded[e]];
         });
         true
     }
