@@ -97,10 +97,14 @@ impl SymmetricDiagonals {
                 }
                 continue;
             }
-            for i in d..n {
-                let a = diagonal[i];
-                y[i] += a * x[i - d];
-                y[i - d] += a * x[i];
+            // The lower triangle's terms, then the upper's: each y_i still receives its two
+            // terms of this diagonal in that order, and neither loop reads what it writes, so
+            // both vectorise (one loop with both chained y_i to y_{i-d}).
+            for ((y, &a), &x) in y[d..n].iter_mut().zip(&diagonal[d..]).zip(&x[..n - d]) {
+                *y += a * x;
+            }
+            for ((y, &a), &x) in y[..n - d].iter_mut().zip(&diagonal[d..]).zip(&x[d..n]) {
+                *y += a * x;
             }
         }
     }
