@@ -16,9 +16,6 @@ const NEIGHBOURS_PER_AXIS: usize = 3;
 /// Hat corners of a cell in at most two dimensions.
 const MAX_CORNERS: usize = 4;
 
-/// Offsets i - j in at most two dimensions.
-const MAX_NEIGHBOURS: usize = NEIGHBOURS_PER_AXIS * NEIGHBOURS_PER_AXIS;
-
 /// Nodes per axis of the block that `eval` sums the gradient into: the stencil block and one
 /// node beyond it on each side. An offset to a node off the grid, whose average is zero, lands
 /// outside the stencil block (or on an entry past a grid of under three cells, which carries
@@ -31,40 +28,26 @@ const MAX_PADDED: usize = PADDED_PER_AXIS * PADDED_PER_AXIS;
 /// Flat-index places per axis (first axis fastest) of the padded block.
 const PADDED_PLACE: [usize; 2] = [1, PADDED_PER_AXIS];
 
-/// The offsets i - j in {-1, 0, 1}^D (first axis fastest) as steps in the padded block.
-const fn padded_steps<const D: usize>() -> [usize; MAX_NEIGHBOURS] {
-    let mut steps = [0; MAX_NEIGHBOURS];
-    let mut offset = 0;
-    while offset < NEIGHBOURS_PER_AXIS.pow(D as u32) {
-        let (mut rest, mut k) = (offset, 0);
-        while k < D {
-            steps[offset] += rest % NEIGHBOURS_PER_AXIS * PADDED_PLACE[k];
-            rest /= NEIGHBOURS_PER_AXIS;
-            k += 1;
-        }
-        offset += 1;
-    }
-    steps
-}
-
-/// Stencil entries in at most two dimensions.
+/// Entries of a block in at most two dimensions: the most a table of places below lists.
 const MAX_STENCIL: usize = NODES_PER_AXIS * NODES_PER_AXIS;
 
-/// The padded-block index of each stencil entry (first axis fastest): the block one node in
-/// from the padding on each side.
-const fn stencil_in_padded<const D: usize>() -> [usize; MAX_STENCIL] {
-    let mut index = [0; MAX_STENCIL];
+/// The places in the padded block of the entries (first axis fastest) of a block of
+/// `per_axis` nodes per axis whose first node lies `shift` nodes in from the padded block's
+/// first: with (3, 0) the offsets i - j in {-1, 0, 1}^D as steps from node j - 1, with (4, 1)
+/// the stencil's entries.
+const fn padded_places<const D: usize>(per_axis: usize, shift: usize) -> [usize; MAX_STENCIL] {
+    let mut places = [0; MAX_STENCIL];
     let mut e = 0;
-    while e < NODES_PER_AXIS.pow(D as u32) {
+    while e < per_axis.pow(D as u32) {
         let (mut rest, mut k) = (e, 0);
         while k < D {
-            index[e] += (rest % NODES_PER_AXIS + 1) * PADDED_PLACE[k];
-            rest /= NODES_PER_AXIS;
+            places[e] += (rest % per_axis + shift) * PADDED_PLACE[k];
+            rest /= per_axis;
             k += 1;
         }
         e += 1;
     }
-    index
+    places
 }
 
 /// How the integrals over the material are taken.
@@ -289,7 +272,7 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
             weight[entry] = hat;
             for (average, step) in self.average[j * stride..(j + 1) * stride]
                 .iter()
-                .zip(&const { padded_steps::<D>() })
+                .zip(&const { padded_places::<D>(NEIGHBOURS_PER_AXIS, 0) })
             {
                 padded[lowest + step] += average * hat;
             }
@@ -298,7 +281,7 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         // copy needs no bounds checks.
         let count = Self::stencil_nodes();
         let (node, grad) = (&mut node[..count], &mut grad[..count]);
-        let in_padded = const { stencil_in_padded::<D>() };
+        let in_padded = const { padded_places::<D>(NODES_PER_AXIS, 1) };
         for_each_block_node::<D, NODES_PER_AXIS>(grid, &start, |e, index, _| {
             node[e] = index as u32;
             grad[e] = padded[in_padded[e]];
