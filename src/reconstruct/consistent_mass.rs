@@ -38,12 +38,8 @@ impl<const D: usize> ConsistentMassTransfer<D> {
         particle_sums(stencils, particles, body_force, grid);
         self.solver.reset(stencils.bandwidth());
         for p in 0..particles.len() {
-            let m = particles.mass[p];
-            for (i, n_i, _) in stencils.of(p).filter(|&(_, n_i, _)| n_i != 0.0) {
-                for (j, n_j, _) in stencils.of(p).filter(|&(j, _, _)| j <= i) {
-                    self.solver.add(i, j, m * n_i * n_j);
-                }
-            }
+            let (nodes, values) = stencils.values_of(p);
+            self.solver.add_point(nodes, values, particles.mass[p]);
         }
         self.solver.prepare(&grid.mass, grid.empty_mass)?;
         self.solver

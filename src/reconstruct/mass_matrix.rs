@@ -109,13 +109,24 @@ impl<const D: usize> MassSolver<D> {
         self.matrix.reset(self.fixed.len(), bandwidth);
     }
 
-    /// Adds `value` to M_ij and M_ji. A zero is not stored: the block stencils list nodes
-    /// their point does not reach (the dual-domain gradient's, the particle domains'), whose
-    /// zeros would widen the matrix's pattern and every product with it.
+    /// Adds one point's share `scale` N_i N_j to M_ij and M_ji for every pair of its stencil
+    /// entries (`nodes`, `values`), i by entry and then j <= i by entry. A zero is not
+    /// stored: the block stencils list nodes their point does not reach (the dual-domain
+    /// gradient's, the particle domains'), whose zeros would widen the matrix's pattern and
+    /// every product with it.
     #[inline]
-    pub fn add(&mut self, i: usize, j: usize, value: f64) {
-        if value != 0.0 {
-            self.matrix.add(i, j, value);
+    pub fn add_point(&mut self, nodes: &[u32], values: &[f64], scale: f64) {
+        for (&i, &n_i) in nodes.iter().zip(values) {
+            if n_i == 0.0 {
+                continue;
+            }
+            let (i, scaled) = (i as usize, scale * n_i);
+            for (&j, &n_j) in nodes.iter().zip(values) {
+                let value = scaled * n_j;
+                if j as usize <= i && value != 0.0 {
+                    self.matrix.add(i, j as usize, value);
+                }
+            }
         }
     }
 

@@ -179,11 +179,10 @@ impl<const D: usize> TaylorTransfer<D> {
                     grid.mass[i] += rho_g * n_i;
                     grid.velocity[i] += rho_v_g * n_i;
                     grid.force[i] -= sigma_g * grad;
-                    if consistent && n_i != 0.0 {
-                        for (j, n_j, _) in self.basis.of(g).filter(|&(j, _, _)| j <= i) {
-                            self.mass_solver.add(i, j, rho_g * n_i * n_j);
-                        }
-                    }
+                }
+                if consistent {
+                    let (nodes, values) = self.basis.values_of(g);
+                    self.mass_solver.add_point(nodes, values, rho_g);
                 }
             }
         }

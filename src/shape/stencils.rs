@@ -151,6 +151,13 @@ impl<const D: usize> Stencils<D> {
             .unwrap_or(0)
     }
 
+    /// The nodes and values N of particle `p`'s entries.
+    #[inline]
+    pub fn values_of(&self, p: usize) -> (&[u32], &[f64]) {
+        let range = p * self.per_point..(p + 1) * self.per_point;
+        (&self.node[range.clone()], &self.weight[range])
+    }
+
     /// Entries of particle `p`: (node, N, grad N).
     #[inline]
     pub fn of(&self, p: usize) -> impl Iterator<Item = (usize, f64, &SVector<f64, D>)> {
