@@ -94,12 +94,19 @@ pub fn for_each_block_node<const D: usize, const A: usize>(
     for e in 0..A.pow(D as u32) {
         let index = (0..D).map(|k| along[k][local[k]]).sum();
         visit(e, index, &local);
-        for k in 0..D {
-            local[k] += 1;
-            if local[k] < A {
-                break;
-            }
-            local[k] = 0;
+        next_block_entry::<D, A>(&mut local);
+    }
+}
+
+/// Moves the coordinates `local` within a block of `A` nodes per axis to the next entry,
+/// the first axis fastest: counted up instead of divided out of the entry index.
+#[inline]
+pub fn next_block_entry<const D: usize, const A: usize>(local: &mut [usize; D]) {
+    for l in local {
+        *l += 1;
+        if *l < A {
+            return;
         }
+        *l = 0;
     }
 }

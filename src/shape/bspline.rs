@@ -3,6 +3,7 @@
 
 use nalgebra::SVector;
 
+use super::block::next_block_entry;
 use super::{Dofs, Grid, Shape};
 
 /// B-splines per axis that are nonzero at a point.
@@ -89,13 +90,7 @@ impl<const D: usize> Shape<D> for QuadraticBSpline {
             node[e] = index as u32;
             weight[e] = w;
             grad[e] = g;
-            for local in &mut locals {
-                *local += 1;
-                if *local < PER_AXIS {
-                    break;
-                }
-                *local = 0;
-            }
+            next_block_entry::<D, PER_AXIS>(&mut locals);
         }
         true
     }
