@@ -85,10 +85,10 @@ impl<const D: usize> Lattice<D> {
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
-        // `as` truncates and saturates below zero, which is floor().max(0.0) here without
-        // a libm call.
-        let first_cell = (s - radius - 1.0) as usize;
-        let last_cell = (s + radius) as usize;
+        // Truncation is floor() here, from the point's cell down to the first cell, without a
+        // libm call; through i64, which converts in one instruction where usize does not.
+        let first_cell = ((s - radius - 1.0) as i64).max(0) as usize;
+        let last_cell = ((s + radius) as i64).max(0) as usize;
         let mut n = 0;
         // Cells, then offsets within a cell: lattice index order without a division.
         'cells: for cell in first_cell..=last_cell {

@@ -210,32 +210,53 @@ impl<const D: usize> Reconstructor<D> {
                     axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
                 }
             }
+            // The entries, first axis fastest, in rows along the first axis: each row's
+            // index part, offsets and weight factors of the other axes are taken once, and
+            // the weight is still the product w_0 w_1 ... in axis order.
             let total: usize = count.iter().product();
-            // An odometer over the per-axis neighbours, the first axis fastest.
-            let mut j = [0usize; D];
-            for _ in 0..total {
-                let mut e = 0;
-                let mut w = 1.0;
-                let mut d = SVector::<f64, D>::zeros();
-                for k in 0..D {
-                    e += index[k][j[k]];
-                    d[k] = axis_offset[k][j[k]];
-                    w *= axis_weight[k][j[k]];
-                }
-                for k in 0..D {
-                    j[k] += 1;
-                    if j[k] < count[k] {
-                        break;
+            let along = count[0];
+            if total > 0 {
+                let rows = point[entry..][..total]
+                    .chunks_exact_mut(along)
+                    .zip(offset[entry..][..total].chunks_exact_mut(along))
+                    .zip(phi[entry..][..total].chunks_exact_mut(along));
+                let mut j = [0usize; D];
+                for ((row_point, row_offset), row_phi) in rows {
+                    let mut row_index = 0;
+                    let mut d = SVector::<f64, D>::zeros();
+                    for k in 1..D {
+                        row_index += index[k][j[k]];
+                        d[k] = axis_offset[k][j[k]];
                     }
-                    j[k] = 0;
+                    let first = index[0][..along]
+                        .iter()
+                        .zip(&axis_offset[0][..along])
+                        .zip(&axis_weight[0][..along]);
+                    let entries = row_point.iter_mut().zip(row_offset).zip(row_phi);
+                    for (((e, d_out), w_out), ((&i, &d0), &w0)) in entries.zip(first) {
+                        let mut w = w0;
+                        for k in 1..D {
+                            w *= axis_weight[k][j[k]];
+                        }
+                        d[0] = d0;
+                        let e_full = i + row_index;
+                        *e = e_full as u32;
+                        *d_out = d;
+                        *w_out = w;
+                        monomials(degree, &d, &mut q);
+                        add_weighted_outer(&mut moments[e_full * T * T..][..T * T], T, w, &q[..T]);
+                    }
+                    // The next row: an odometer over the axes after the first.
+                    for k in 1..D {
+                        j[k] += 1;
+                        if j[k] < count[k] {
+                            break;
+                        }
+                        j[k] = 0;
+                    }
                 }
-                point[entry] = e as u32;
-                offset[entry] = d;
-                phi[entry] = w;
-                entry += 1;
-                monomials(degree, &d, &mut q);
-                add_weighted_outer(&mut moments[e * T * T..][..T * T], T, w, &q[..T]);
             }
+            entry += total;
             start[p + 1] = entry;
         }
     }
