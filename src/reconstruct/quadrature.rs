@@ -5,8 +5,10 @@
 //! points, where the nodal masses and forces are integrated.
 
 use std::fmt;
+use std::ops::{Add, AddAssign, Mul};
 
 use nalgebra::{SMatrix, SVector};
+use num_traits::Zero;
 
 use super::shepard::{map_velocity, remap_velocity};
 use super::{FitStats, GridState, Lattice, Recipe, Reconstructor, SingularMoments};
@@ -92,13 +94,66 @@ pub struct QuadratureTransfer<const D: usize> {
     basis: Stencils<D>,
     /// Quadrature weights omega_g.
     weights: Vec<f64>,
-    particle_density: Vec<f64>,
-    /// rho_p b_p, for the product fit.
-    particle_body: Vec<SVector<f64, D>>,
+    /// The fitted fields at the particles, then at the quadrature points.
+    particle_fields: Vec<Fields<D>>,
+    fields_at_points: Vec<Fields<D>>,
     body_force: BodyForceFit,
-    density: Vec<f64>,
-    stress: Vec<SMatrix<f64, D, D>>,
-    body: Vec<SVector<f64, D>>,
+}
+
+/// The fields one quadrature transfer fits: density, stress, and b or rho b (the body-force
+/// fit). One fit applied to all of them at once is, field by field, the same arithmetic as a
+/// fit applied to each, with one pass over the entries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Fields<const D: usize> {
+    density: f64,
+    stress: SMatrix<f64, D, D>,
+    body: SVector<f64, D>,
+}
+
+impl<const D: usize> Zero for Fields<D> {
+    fn zero() -> Self {
+        Fields {
+            density: 0.0,
+            stress: SMatrix::zeros(),
+            body: SVector::zeros(),
+        }
+    }
+
+    fn is_zero(&self) -> bool {
+        *self == Self::zero()
+    }
+}
+
+impl<const D: usize> Add for Fields<D> {
+    type Output = Self;
+
+    fn add(self, other: Self) -> Self {
+        Fields {
+            density: self.density + other.density,
+            stress: self.stress + other.stress,
+            body: self.body + other.body,
+        }
+    }
+}
+
+impl<const D: usize> AddAssign for Fields<D> {
+    fn add_assign(&mut self, other: Self) {
+        self.density += other.density;
+        self.stress += other.stress;
+        self.body += other.body;
+    }
+}
+
+impl<const D: usize> Mul<f64> for Fields<D> {
+    type Output = Self;
+
+    fn mul(self, phi: f64) -> Self {
+        Fields {
+            density: self.density * phi,
+            stress: self.stress * phi,
+            body: self.body * phi,
+        }
+    }
 }
 
 impl<const D: usize> QuadratureTransfer<D> {
@@ -121,12 +176,9 @@ impl<const D: usize> QuadratureTransfer<D> {
             fields: Reconstructor::new(recipe.fields, points),
             basis,
             weights,
-            particle_density: Vec::new(),
-            particle_body: Vec::new(),
+            particle_fields: Vec::new(),
+            fields_at_points: vec![Fields::zero(); n],
             body_force: recipe.body_force,
-            density: vec![0.0; n],
-            stress: vec![SMatrix::zeros(); n],
-            body: vec![SVector::zeros(); n],
         }
     }
 
@@ -157,31 +209,27 @@ impl<const D: usize> QuadratureTransfer<D> {
             }
         }
         stats += self.fields.fit(&particles.x)?;
-        self.particle_density.clear();
-        self.particle_density
-            .extend((0..particles.len()).map(|p| particles.mass[p] / particles.volume(p)));
-        self.fields.apply(&self.particle_density, &mut self.density);
-        self.fields.apply(&particles.stress, &mut self.stress);
-        match self.body_force {
-            BodyForceFit::Separate => self.fields.apply(body_force, &mut self.body),
-            BodyForceFit::Product => {
-                self.particle_body.clear();
-                self.particle_body.extend(
-                    body_force
-                        .iter()
-                        .zip(&self.particle_density)
-                        .map(|(b, rho)| b * *rho),
-                );
-                self.fields.apply(&self.particle_body, &mut self.body);
+        self.particle_fields.clear();
+        self.particle_fields.extend((0..particles.len()).map(|p| {
+            let density = particles.mass[p] / particles.volume(p);
+            Fields {
+                density,
+                stress: particles.stress[p],
+                body: match self.body_force {
+                    BodyForceFit::Separate => body_force[p],
+                    BodyForceFit::Product => body_force[p] * density,
+                },
             }
-        }
-        for g in 0..self.weights.len() {
-            let rho_omega = self.density[g] * self.weights[g];
+        }));
+        self.fields
+            .apply(&self.particle_fields, &mut self.fields_at_points);
+        for (g, at_point) in self.fields_at_points.iter().enumerate() {
+            let rho_omega = at_point.density * self.weights[g];
             let body = match self.body_force {
-                BodyForceFit::Separate => self.body[g] * rho_omega,
-                BodyForceFit::Product => self.body[g] * self.weights[g],
+                BodyForceFit::Separate => at_point.body * rho_omega,
+                BodyForceFit::Product => at_point.body * self.weights[g],
             };
-            let stress = self.stress[g] * self.weights[g];
+            let stress = at_point.stress * self.weights[g];
             for (i, n, grad) in self.basis.of(g) {
                 grid.mass[i] += n * rho_omega;
                 grid.force[i] += body * n - stress * grad;
