@@ -155,22 +155,24 @@ impl<const D: usize> Reconstructor<D> {
     /// Builds the shape functions for particles at `x`. Points no particle reaches get
     /// zero shape functions and are not counted.
     pub fn fit(&mut self, x: &[SVector<f64, D>]) -> Result<FitStats, SingularMoments> {
-        // The basis size as a constant lets the per-entry loops over terms unroll.
+        // The basis size (and the moment matrix's, `TT` = T^2) as constants lets the
+        // per-entry loops over terms unroll and a point's matrix be indexed as one array.
         match self.terms {
-            1 => self.fit_with::<1>(x),
-            2 => self.fit_with::<2>(x),
-            3 => self.fit_with::<3>(x),
-            MAX_TERMS => self.fit_with::<MAX_TERMS>(x),
+            1 => self.fit_with::<1, 1>(x),
+            2 => self.fit_with::<2, 4>(x),
+            3 => self.fit_with::<3, 9>(x),
+            MAX_TERMS => self.fit_with::<MAX_TERMS, { MAX_TERMS * MAX_TERMS }>(x),
             t => unreachable!("no basis has {t} terms"),
         }
     }
 
-    fn fit_with<const T: usize>(
+    fn fit_with<const T: usize, const TT: usize>(
         &mut self,
         x: &[SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
-        self.gather_weights::<T>(x);
+        debug_assert_eq!(TT, T * T);
+        self.gather_weights::<T, TT>(x);
         let stats = self.solve::<T>()?;
         self.finish_shape_functions::<T>();
         Ok(stats)
@@ -178,7 +180,7 @@ impl<const D: usize> Reconstructor<D> {
 
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
     /// the moment matrices, summed particle by particle in order.
-    fn gather_weights<const T: usize>(&mut self, x: &[SVector<f64, D>]) {
+    fn gather_weights<const T: usize, const TT: usize>(&mut self, x: &[SVector<f64, D>]) {
         // Sized for the most entries once; indexed writes are cheaper than pushes.
         let capacity = x.len() * self.max_entries;
         self.point.resize(capacity, 0);
@@ -189,7 +191,7 @@ impl<const D: usize> Reconstructor<D> {
         // Borrowed apart so the loop keeps them in registers.
         let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
         let (point, offset, phi) = (&mut self.point[..], &mut self.offset[..], &mut self.phi[..]);
-        let (start, moments) = (&mut self.start[..], &mut self.moments[..]);
+        let (start, moments) = (&mut self.start[..], self.moments.as_chunks_mut::<TT>().0);
         let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
         // Per axis and neighbour: the part of the lattice index, the offset and the 1D
         // weight factor, so each entry only combines them.
@@ -244,7 +246,7 @@ impl<const D: usize> Reconstructor<D> {
                         *d_out = d;
                         *w_out = w;
                         monomials(degree, &d, &mut q);
-                        add_weighted_outer(&mut moments[e_full * T * T..][..T * T], T, w, &q[..T]);
+                        add_weighted_outer(&mut moments[e_full], T, w, &q[..T]);
                     }
                     // The next row: an odometer over the axes after the first.
                     for k in 1..D {
