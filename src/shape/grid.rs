@@ -110,8 +110,10 @@ impl<const D: usize> Grid<D> {
             if !(s >= 0.0 && s <= self.cells as f64) {
                 return None;
             }
-            let c = (s as usize).min(self.cells - 1);
-            cell[k] = c;
+            // Through i64, which converts to and from f64 in one instruction each where usize
+            // does not; s is in [0, cells] here, so the values are the same.
+            let c = (s as i64).min(self.cells as i64 - 1);
+            cell[k] = c as usize;
             xi[k] = s - c as f64;
         }
         Some((cell, xi))
