@@ -29,7 +29,9 @@ pub fn block_start<const D: usize>(
     let last_start = last_start(grid, per_axis);
     let mut start = [0; D];
     for k in 0..D {
-        start[k] = (lo[k].floor().max(0.0) as usize).min(last_start);
+        // Truncation through i64 then max(0) is floor().max(0.0) for every input, NaN and
+        // infinities included, without a call to floor or usize's conversion branches.
+        start[k] = ((lo[k] as i64).max(0) as usize).min(last_start);
         if hi[k] > (start[k] + per_axis - 1) as f64 {
             return None;
         }
