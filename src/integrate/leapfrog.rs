@@ -78,6 +78,10 @@ pub fn synchronized_velocity_of<const D: usize>(
     half: f64,
     p: usize,
 ) -> SVector<f64, D> {
-    let a: SVector<f64, D> = stencils.of(p).map(|(i, w, _)| grid.force[i] * w).sum();
+    let a: SVector<f64, D> = stencils
+        .for_values()
+        .of(p)
+        .map(|(i, w, _)| grid.force[i] * w)
+        .sum();
     particles.v[p] + a * half
 }

@@ -27,7 +27,7 @@ pub fn move_particles<const D: usize>(
     for p in 0..particles.len() {
         let mut a = SVector::<f64, D>::zeros();
         let mut v = SVector::<f64, D>::zeros();
-        for (i, w, _) in stencils.of(p) {
+        for (i, w, _) in stencils.for_values().of(p) {
             a += grid.force[i] * w;
             v += drift[i] * w;
         }

@@ -38,7 +38,7 @@ impl<const D: usize> ConsistentMassTransfer<D> {
         particle_sums(stencils, particles, body_force, grid);
         self.solver.reset(stencils.bandwidth());
         for p in 0..particles.len() {
-            let (nodes, values) = stencils.values_of(p);
+            let (nodes, values) = stencils.for_values().values_of(p);
             self.solver.add_point(nodes, values, particles.mass[p]);
         }
         self.solver.prepare(&grid.mass, grid.empty_mass)?;

@@ -30,6 +30,12 @@ pub fn particle_sums<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
+    if stencils.has_value_entries() {
+        // Mass and momentum over the entries with values, the forces over all of them.
+        lumped_sums(stencils, &particles.mass, &particles.v, grid);
+        nodal_forces(stencils, particles, body_force, &mut grid.force);
+        return;
+    }
     grid.clear();
     let len = parallel::block_len(grid.mass.len());
     let blocks = grid
@@ -64,11 +70,23 @@ pub fn map_velocity<const D: usize>(
     velocity: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
+    lumped_sums(stencils, mass, velocity, grid);
+    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
+}
+
+/// m_i = sum_p M_p N_ip and the momenta sum_p M_p u_p N_ip into `grid.velocity`, the rest of
+/// `grid` cleared.
+fn lumped_sums<const D: usize>(
+    stencils: &Stencils<D>,
+    mass: &[f64],
+    velocity: &[SVector<f64, D>],
+    grid: &mut GridState<D>,
+) {
     grid.clear();
     let len = parallel::block_len(grid.mass.len());
     let blocks = grid.mass.chunks_mut(len).zip(grid.velocity.chunks_mut(len));
     let point = |p: usize| (mass[p], velocity[p] * mass[p]);
-    stencils.scatter(
+    stencils.for_values().scatter(
         mass.len(),
         len,
         blocks,
@@ -78,7 +96,6 @@ pub fn map_velocity<const D: usize>(
             momentum[i] += mu * w;
         },
     );
-    momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
 }
 
 /// The forces of `particles_to_grid` alone, into `force`: f_i = sum_p (M_p b_p N_ip -
@@ -125,7 +142,7 @@ pub fn momentum_sums<const D: usize>(
 ) {
     out.fill(SVector::zeros());
     let len = parallel::block_len(out.len());
-    stencils.scatter(
+    stencils.for_values().scatter(
         particles.len(),
         len,
         out.chunks_mut(len),

@@ -188,7 +188,7 @@ impl<const D: usize> TaylorTransfer<D> {
         }
         for p in 0..particles.len() {
             let mb = body_force[p] * particles.mass[p];
-            for (i, w, _) in stencils.of(p) {
+            for (i, w, _) in stencils.for_values().of(p) {
                 grid.force[i] += mb * w;
             }
         }

@@ -234,6 +234,11 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         Self::stencil_nodes()
     }
 
+    /// The hat's values, at the corners of the point's cell.
+    fn value_nodes_per_point(&self) -> usize {
+        1 << D
+    }
+
     fn eval(
         &self,
         grid: &Grid<D>,
@@ -297,7 +302,7 @@ mod tests {
     use super::*;
     use crate::benchmarks::Domain;
     use crate::rng::Lcg;
-    use crate::shape::lattice_coords;
+    use crate::shape::{lattice_coords, Stencils};
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
         Grid::new(&Domain {
@@ -401,6 +406,54 @@ mod tests {
     fn dual_domain_gradient_is_consistent_where_there_is_material_2d() {
         check_consistency::<2>(DualIntegrals::Particles);
         check_consistency::<2>(DualIntegrals::ActiveCells);
+    }
+
+    /// The value entries list each point's nonzero values in stencil order (at most the 2^D
+    /// corners of its cell, on faces and at the grid's ends too), and sums over them equal the
+    /// sums over the whole stencil bit for bit.
+    fn check_value_entries<const D: usize>() {
+        let g = grid::<D>(5);
+        let mut rng = Lcg::new(2018);
+        let positions: Vec<SVector<f64, D>> = (0..200)
+            .map(|n| match n % 4 {
+                // On a cell face, where an upper corner's hat is zero.
+                0 => SVector::from_fn(|_, _| (5.0 * rng.unit()).floor() / 5.0),
+                // At the grid's ends, where the block is shifted inwards.
+                1 => SVector::from_fn(|k, _| if k == 0 { 1.0 } else { rng.unit() }),
+                _ => SVector::from_fn(|_, _| rng.unit()),
+            })
+            .collect();
+        let volumes = vec![1e-3; positions.len()];
+        let dual = integrated(&g, DualIntegrals::Particles, &positions, &volumes);
+        let mut st = Stencils::new(dual.nodes_per_point(), positions.len());
+        st.update(&dual, &g, &positions).unwrap();
+        assert!(st.has_value_entries());
+        let values = st.for_values();
+        assert_eq!(values.per_point, 1 << D);
+        let u: Vec<f64> = (0..g.num_nodes()).map(|_| rng.unit() - 0.5).collect();
+        for p in 0..positions.len() {
+            let nonzero: Vec<(usize, f64)> = st
+                .of(p)
+                .filter(|(_, w, _)| *w != 0.0)
+                .map(|(i, w, _)| (i, w))
+                .collect();
+            let listed: Vec<(usize, f64)> = values.of(p).map(|(i, w, _)| (i, w)).collect();
+            assert_eq!(&listed[..nonzero.len()], &nonzero[..]);
+            assert!(listed[nonzero.len()..].iter().all(|&(_, w)| w == 0.0));
+            let full: f64 = st.of(p).map(|(i, w, _)| u[i] * w).sum();
+            let compact: f64 = values.of(p).map(|(i, w, _)| u[i] * w).sum();
+            assert_eq!(full.to_bits(), compact.to_bits());
+        }
+    }
+
+    #[test]
+    fn value_entries_are_the_nonzero_values_1d() {
+        check_value_entries::<1>();
+    }
+
+    #[test]
+    fn value_entries_are_the_nonzero_values_2d() {
+        check_value_entries::<2>();
     }
 
     /// `ppc` particles per cell and axis at the centres of equal sub-cells (the seeding), each

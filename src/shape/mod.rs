@@ -28,6 +28,13 @@ pub trait Shape<const D: usize>: Sync {
     /// zero weight and gradient).
     fn nodes_per_point(&self) -> usize;
 
+    /// How many of a stencil's entries can carry nonzero values, where fewer than
+    /// `nodes_per_point` do (the dual-domain basis: the hat's 2^D of 4^D nodes); sums of
+    /// values then run over those entries alone (`Stencils::for_values`).
+    fn value_nodes_per_point(&self) -> usize {
+        self.nodes_per_point()
+    }
+
     /// Fills the nodes, values N_i(x) and gradients grad N_i(x) of the stencil of `x`.
     /// Returns false when `x` is outside the grid.
     fn eval(

@@ -12,6 +12,9 @@ pub struct Stencils<const D: usize> {
     pub node: Vec<u32>,
     pub weight: Vec<f64>,
     pub grad: Vec<SVector<f64, D>>,
+    /// For a basis whose values reach fewer nodes than its gradients, each point's entries
+    /// with nonzero values in stencil order, padded with zero values (gradients unused).
+    values: Option<Box<Stencils<D>>>,
 }
 
 impl<const D: usize> Stencils<D> {
@@ -22,7 +25,22 @@ impl<const D: usize> Stencils<D> {
             node: filled(n, 0, "the stencils' nodes"),
             weight: filled(n, 0.0, "the stencils' values"),
             grad: filled(n, SVector::zeros(), "the stencils' gradients"),
+            values: None,
         }
+    }
+
+    /// The entries to sum values over (mass, momentum, N-weighted gathers): each point's
+    /// entries with nonzero values where the basis has fewer of them than gradients, else
+    /// all of them. The terms left out add exact zeros to sums that start from +0, so every
+    /// sum is the same to the last bit.
+    #[inline]
+    pub fn for_values(&self) -> &Stencils<D> {
+        self.values.as_deref().unwrap_or(self)
+    }
+
+    /// Whether `for_values` lists fewer entries than these stencils.
+    pub fn has_value_entries(&self) -> bool {
+        self.values.is_some()
     }
 
     /// Gives every point `per_point` entries, all zero until filled again.
@@ -67,7 +85,58 @@ impl<const D: usize> Stencils<D> {
             }
             Ok(())
         };
-        parallel::map_chunks(chunks, evaluate).into_iter().collect()
+        parallel::map_chunks(chunks, evaluate)
+            .into_iter()
+            .collect::<Result<(), usize>>()?;
+        let value_nodes = shape.value_nodes_per_point();
+        if value_nodes < k {
+            let points = self.node.len() / k;
+            let mut values = match self.values.take() {
+                Some(values) if values.node.len() == value_nodes * points => values,
+                _ => Box::new(Stencils::new(value_nodes, points)),
+            };
+            self.copy_values_to(&mut values);
+            self.values = Some(values);
+        } else {
+            self.values = None;
+        }
+        Ok(())
+    }
+
+    /// Each point's entries with nonzero values into `values` (`values.per_point` of them per
+    /// point), in stencil order, the rest of its entries zero values at the point's first node.
+    fn copy_values_to(&self, values: &mut Stencils<D>) {
+        let (k, v) = (self.per_point, values.per_point);
+        let targets = values
+            .node
+            .chunks_mut(v * parallel::CHUNK)
+            .zip(values.weight.chunks_mut(v * parallel::CHUNK));
+        let sources = self
+            .node
+            .chunks(k * parallel::CHUNK)
+            .zip(self.weight.chunks(k * parallel::CHUNK));
+        type Target<'a> = (&'a mut [u32], &'a mut [f64]);
+        type Source<'a> = (&'a [u32], &'a [f64]);
+        let copy = |((to_node, to_weight), (node, weight)): (Target, Source)| {
+            let points = to_node
+                .chunks_exact_mut(v)
+                .zip(to_weight.chunks_exact_mut(v))
+                .zip(node.chunks_exact(k))
+                .zip(weight.chunks_exact(k));
+            for (((to_node, to_weight), node), weight) in points {
+                to_node.fill(node[0]);
+                to_weight.fill(0.0);
+                let nonzero = node.iter().zip(weight).filter(|(_, &w)| w != 0.0);
+                for ((to_node, to_weight), (&i, &w)) in
+                    to_node.iter_mut().zip(to_weight.iter_mut()).zip(nonzero)
+                {
+                    *to_node = i;
+                    *to_weight = w;
+                }
+                debug_assert!(weight.iter().filter(|&&w| w != 0.0).count() <= v);
+            }
+        };
+        parallel::map_chunks(targets.zip(sources), copy);
     }
 
     /// Adds the contributions of points `0..points` to nodal arrays cut into blocks of
