@@ -197,11 +197,17 @@ impl<const D: usize> TaylorFit<D> {
         self.psi.clear();
         self.psi
             .extend(points.iter().map(|x| cell.basis(requested, x)));
-        let mut normal: Moments = [0.0; MAX_TERMS * MAX_TERMS];
-        for psi in &self.psi {
-            add_weighted_outer(&mut normal, MAX_TERMS, 1.0, &psi[prescribed..terms]);
-        }
-        let mut basis = OrthogonalBasis::from_moments(&normal, terms - prescribed);
+        // The number of fitted functions as a constant lets the loops over them unroll.
+        let mut basis = match terms - prescribed {
+            0 => normal_basis::<0>(&self.psi, prescribed),
+            1 => normal_basis::<1>(&self.psi, prescribed),
+            2 => normal_basis::<2>(&self.psi, prescribed),
+            3 => normal_basis::<3>(&self.psi, prescribed),
+            4 => normal_basis::<4>(&self.psi, prescribed),
+            5 => normal_basis::<5>(&self.psi, prescribed),
+            MAX_TERMS => normal_basis::<MAX_TERMS>(&self.psi, prescribed),
+            f => unreachable!("no Taylor fit has {f} fitted functions"),
+        };
         // The first unsupported function caps the degree below its own; the polynomials before
         // it do not depend on the ones after it, so the factorisation truncates.
         let supported = (0..terms - prescribed)
@@ -227,9 +233,27 @@ impl<const D: usize> TaylorFit<D> {
             self.psi.len(),
             "one value per point of the factorisation"
         );
+        // The number of fitted functions as a constant lets the per-point loops unroll.
+        match self.terms - self.prescribed {
+            0 => self.solve_with::<T, 0>(values, mean),
+            1 => self.solve_with::<T, 1>(values, mean),
+            2 => self.solve_with::<T, 2>(values, mean),
+            3 => self.solve_with::<T, 3>(values, mean),
+            4 => self.solve_with::<T, 4>(values, mean),
+            5 => self.solve_with::<T, 5>(values, mean),
+            MAX_TERMS => self.solve_with::<T, MAX_TERMS>(values, mean),
+            f => unreachable!("no Taylor fit has {f} fitted functions"),
+        }
+    }
+
+    /// `solve` with `F` fitted functions.
+    fn solve_with<T: Fitted, const F: usize>(
+        &self,
+        values: &[T],
+        mean: T,
+    ) -> [T; MAX_TAYLOR_TERMS] {
         let zero = T::splat(0.0);
         let first = self.prescribed;
-        let fitted = self.terms - first;
         let shift = if first == 1 { mean } else { zero };
         // A solve, then one refinement with its residual (module notes): the correction
         // converges because kappa^2 eps <= 1e-6 wherever the rank test passed.
@@ -238,15 +262,16 @@ impl<const D: usize> TaylorFit<D> {
             // <psi_j, u - shift - sum_k c_k psi_k> over the data, point by point in order.
             let mut rhs = [zero; MAX_TERMS];
             for (psi, &u) in self.psi.iter().zip(values) {
+                let psi = &psi[first..][..F];
                 // From -0.0, as `Sum` for f64 starts.
-                let fit = (0..fitted).fold(T::splat(-0.0), |sum, k| sum + c[k] * psi[first + k]);
+                let fit = (0..F).fold(T::splat(-0.0), |sum, k| sum + c[k] * psi[k]);
                 let r = u - shift - fit;
-                for j in 0..fitted {
-                    rhs[j] += r * psi[first + j];
+                for j in 0..F {
+                    rhs[j] += r * psi[j];
                 }
             }
             let correction = self.basis.solve(&rhs);
-            for j in 0..fitted {
+            for j in 0..F {
                 c[j] += correction[j];
             }
         }
@@ -254,7 +279,7 @@ impl<const D: usize> TaylorFit<D> {
         if first == 1 {
             a[0] = mean;
         }
-        a[first..self.terms].copy_from_slice(&c[..fitted]);
+        a[first..self.terms].copy_from_slice(&c[..F]);
         a
     }
 
@@ -262,6 +287,16 @@ impl<const D: usize> TaylorFit<D> {
     pub fn degree(&self) -> usize {
         self.degree
     }
+}
+
+/// The orthogonal polynomials of the normal matrix sum_p psi psi^T of the `N` functions from
+/// `first` on, summed point by point in order.
+fn normal_basis<const N: usize>(psi: &[[f64; MAX_TAYLOR_TERMS]], first: usize) -> OrthogonalBasis {
+    let mut normal: Moments = [0.0; MAX_TERMS * MAX_TERMS];
+    for psi in psi {
+        add_weighted_outer(&mut normal, MAX_TERMS, 1.0, &psi[first..][..N]);
+    }
+    OrthogonalBasis::from_rows(&normal, MAX_TERMS, N)
 }
 
 #[cfg(test)]
