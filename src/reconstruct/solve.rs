@@ -122,20 +122,8 @@ impl OrthogonalBasis {
     /// several fields at once (`Fitted`), each solved with a scalar's arithmetic.
     #[inline]
     pub fn solve<T: Fitted>(&self, rhs: &[T; MAX_TERMS]) -> [T; MAX_TERMS] {
-        self.solve_terms(rhs, self.terms)
-    }
-
-    /// `solve` for a basis of `terms` polynomials, which callers that know the count as a
-    /// constant pass so that the loops unroll.
-    #[inline(always)]
-    pub(super) fn solve_terms<T: Fitted>(
-        &self,
-        rhs: &[T; MAX_TERMS],
-        terms: usize,
-    ) -> [T; MAX_TERMS] {
-        debug_assert_eq!(terms, self.terms);
         let mut out = [T::splat(0.0); MAX_TERMS];
-        for i in 0..terms {
+        for i in 0..self.terms {
             if !self.kept[i] {
                 continue;
             }

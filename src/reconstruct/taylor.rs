@@ -270,7 +270,7 @@ impl<const D: usize> TaylorFit<D> {
                     rhs[j] += r * psi[j];
                 }
             }
-            let correction = self.basis.solve_terms(&rhs, F);
+            let correction = self.basis.solve(&rhs);
             for j in 0..F {
                 c[j] += correction[j];
             }
