@@ -1,7 +1,7 @@
 //! Particle-steps per second of each method on the manufactured solutions and a large-strain
-//! bar, one core, with each run's wall time relative to `mpm`'s on the same case in the same
-//! invocation and, on the 2D case, the cost each method should come within; and the cost of
-//! one LME evaluation (its Newton solve) against the hat's.
+//! bar, one core, with each run's wall time relative to `mpm`'s on the same case, timed
+//! alternately with it, and, on the 2D case, the cost each method should come within; and the
+//! cost of one LME evaluation (its Newton solve) against the hat's.
 //! Beside the times, each run's peak heap per particle (a counting allocator: what the run
 //! allocates above what was live when it started, over its particles).
 //! Run with `cargo bench --bench throughput` (or `make bench`); a bare word filters by method
@@ -249,9 +249,15 @@ fn lme_evaluation_costs() {
 }
 
 /// The best wall time of `spec` over up to three runs (the machine is shared, the minimum is
-/// the least disturbed; runs over ten seconds are timed once), its peak heap and its record.
-fn timed(spec: &RunSpec) -> (f64, usize, mpmlab::output::RunRecord) {
+/// the least disturbed; runs over ten seconds are timed once), its peak heap and its record,
+/// and with a `reference` the best wall time of that over as many runs, each right after one
+/// of `spec`'s, so that a change in the machine's speed reaches both times of the ratio.
+fn timed(
+    spec: &RunSpec,
+    reference: Option<&RunSpec>,
+) -> (f64, f64, usize, mpmlab::output::RunRecord) {
     let mut best = f64::INFINITY;
+    let mut best_reference = f64::INFINITY;
     let mut peak = 0;
     let mut record = None;
     for _ in 0..3 {
@@ -263,8 +269,23 @@ fn timed(spec: &RunSpec) -> (f64, usize, mpmlab::output::RunRecord) {
         best = best.min(started.elapsed().as_secs_f64());
         peak = bytes;
         record = Some(r);
+        if let Some(reference) = reference {
+            let started = Instant::now();
+            simulate(reference);
+            best_reference = best_reference.min(started.elapsed().as_secs_f64());
+        }
     }
-    (best, peak, record.expect("three runs were made"))
+    let reference_seconds = if reference.is_some() {
+        best_reference
+    } else {
+        best
+    };
+    (
+        best,
+        reference_seconds,
+        peak,
+        record.expect("three runs were made"),
+    )
 }
 
 fn main() {
@@ -283,14 +304,13 @@ fn main() {
         "B/particle"
     );
     let variants = variants(filter.as_deref());
+    let mpm = variants.iter().find(|v| v.label == "mpm");
     for case in CASES {
-        let mut mpm_seconds = f64::NAN;
+        let reference = mpm.map(|mpm| spec(case, mpm));
         for variant in &variants {
-            let spec = spec(case, variant);
-            let (seconds, peak, record) = timed(&spec);
-            if variant.label == "mpm" {
-                mpm_seconds = seconds;
-            }
+            // `mpm` itself is its own reference.
+            let beside = reference.as_ref().filter(|_| variant.label != "mpm");
+            let (seconds, mpm_seconds, peak, record) = timed(&spec(case, variant), beside);
             if record.status != RunStatus::Ok {
                 println!(
                     "{:<24} {:<14} {}: {}",
