@@ -275,11 +275,7 @@ fn timed(
             best_reference = best_reference.min(started.elapsed().as_secs_f64());
         }
     }
-    let reference_seconds = if reference.is_some() {
-        best_reference
-    } else {
-        best
-    };
+    let reference_seconds = reference.map_or(best, |_| best_reference);
     (
         best,
         reference_seconds,
