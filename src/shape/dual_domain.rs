@@ -16,38 +16,50 @@ const NEIGHBOURS_PER_AXIS: usize = 3;
 /// Hat corners of a cell in at most two dimensions.
 const MAX_CORNERS: usize = 4;
 
-/// Nodes per axis of the block that `eval` sums the gradient into: the stencil block and one
-/// node beyond it on each side. An offset to a node off the grid, whose average is zero, lands
-/// outside the stencil block (or on an entry past a grid of under three cells, which carries
-/// zero), so the sums need no test for the grid's ends.
-const PADDED_PER_AXIS: usize = NODES_PER_AXIS + 2;
+/// Block places (first axis fastest) per axis in at most two dimensions.
+const BLOCK_PLACE: [usize; 2] = [1, NODES_PER_AXIS];
 
-/// Nodes of the padded block in at most two dimensions.
-const MAX_PADDED: usize = PADDED_PER_AXIS * PADDED_PER_AXIS;
+/// Entry (first axis fastest) of the block node at coordinates `local`.
+const fn block_entry<const D: usize>(local: &[usize; D]) -> usize {
+    let (mut entry, mut k) = (0, 0);
+    while k < D {
+        entry += local[k] * BLOCK_PLACE[k];
+        k += 1;
+    }
+    entry
+}
 
-/// Flat-index places per axis (first axis fastest) of the padded block.
-const PADDED_PLACE: [usize; 2] = [1, PADDED_PER_AXIS];
-
-/// Entries of a block in at most two dimensions: the most a table of places below lists.
-const MAX_STENCIL: usize = NODES_PER_AXIS * NODES_PER_AXIS;
-
-/// The places in the padded block of the entries (first axis fastest) of a block of
-/// `per_axis` nodes per axis whose first node lies `shift` nodes in from the padded block's
-/// first: with (3, 0) the offsets i - j in {-1, 0, 1}^D as steps from node j - 1, with (4, 1)
-/// the stencil's entries.
-const fn padded_places<const D: usize>(per_axis: usize, shift: usize) -> [usize; MAX_STENCIL] {
-    let mut places = [0; MAX_STENCIL];
-    let mut e = 0;
-    while e < per_axis.pow(D as u32) {
-        let (mut rest, mut k) = (e, 0);
+/// Per offset o in {0, 1, 2}^D (first axis fastest), the block entry of o counted from the
+/// block's first node.
+const fn neighbour_steps<const D: usize>() -> [usize; 9] {
+    let mut steps = [0; 9];
+    let mut n = 0;
+    while n < NEIGHBOURS_PER_AXIS.pow(D as u32) {
+        let (mut rest, mut k) = (n, 0);
         while k < D {
-            places[e] += (rest % per_axis + shift) * PADDED_PLACE[k];
-            rest /= per_axis;
+            steps[n] += rest % NEIGHBOURS_PER_AXIS * BLOCK_PLACE[k];
+            rest /= NEIGHBOURS_PER_AXIS;
             k += 1;
         }
-        e += 1;
+        n += 1;
     }
-    places
+    steps
+}
+
+/// Bit n set for each offset o in {0, 1, 2}^D (n = o in base 3, first axis fastest) that
+/// takes the block node at `local` to block node `local + o - 1`.
+fn neighbours_in_block<const D: usize>(local: &[usize; D]) -> u32 {
+    let (mut reached, mut width) = (1, 1);
+    for &l in local {
+        let mut next = 0;
+        for o in 0..NEIGHBOURS_PER_AXIS {
+            if (1..=NODES_PER_AXIS).contains(&(l + o)) {
+                next |= reached << (o * width);
+            }
+        }
+        (reached, width) = (next, width * NEIGHBOURS_PER_AXIS);
+    }
+    reached
 }
 
 /// How the integrals over the material are taken.
@@ -252,44 +264,42 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         };
         let start = block_around_cell(grid, &cell);
         let stride = DualDomain::<D>::neighbours();
+        // Slices cut to the entry count, so that zeroing them is a few stores, not a call.
+        let count = Self::stencil_nodes();
+        let (node, weight, grad) = (&mut node[..count], &mut weight[..count], &mut grad[..count]);
         weight.fill(0.0);
-        let mut padded = [SVector::<f64, D>::zeros(); MAX_PADDED];
+        grad.fill(SVector::zeros());
         let base = grid.node_index(cell);
         for b in 0..1 << D {
-            // The hat of corner j = b of the cell, as `LinearHat` evaluates it.
+            // The hat of corner j = b of the cell, as `LinearHat` evaluates it, and the
+            // corner's coordinates in the block.
             let mut hat = 1.0;
             let mut j = base;
-            let mut entry = 0;
-            let mut place = 1;
-            // The padded entry of node j - 1 per axis.
-            let mut lowest = 0;
-            let mut padded_place = 1;
+            let mut local = [0; D];
             for k in 0..D {
                 let upper = b >> k & 1;
                 hat *= if upper == 1 { xi[k] } else { 1.0 - xi[k] };
                 j += upper * grid.stride(k);
-                let local = cell[k] + upper - start[k];
-                entry += local * place;
-                lowest += local * padded_place;
-                place *= NODES_PER_AXIS;
-                padded_place *= PADDED_PER_AXIS;
+                local[k] = cell[k] + upper - start[k];
             }
+            let entry = block_entry::<D>(&local);
             weight[entry] = hat;
-            for (average, step) in self.average[j * stride..(j + 1) * stride]
+            // The neighbours i = j + o - 1 (o in {0, 1, 2}^D) that are in the block: those
+            // outside it are off the grid, where the averages are zero.
+            let reached = neighbours_in_block(&local);
+            let first = entry.wrapping_sub(const { block_entry::<D>(&[1; D]) });
+            let neighbours = self.average[j * stride..(j + 1) * stride]
                 .iter()
-                .zip(&const { padded_places::<D>(NEIGHBOURS_PER_AXIS, 0) })
-            {
-                padded[lowest + step] += average * hat;
+                .zip(&const { neighbour_steps::<D>() })
+                .enumerate();
+            for (n, (average, step)) in neighbours {
+                if reached >> n & 1 == 1 {
+                    grad[first.wrapping_add(*step)] += average * hat;
+                }
             }
         }
-        // Slices cut to the entry count and a constant table of padded places, so that the
-        // copy needs no bounds checks.
-        let count = Self::stencil_nodes();
-        let (node, grad) = (&mut node[..count], &mut grad[..count]);
-        let in_padded = const { padded_places::<D>(NODES_PER_AXIS, 1) };
         for_each_block_node::<D, NODES_PER_AXIS>(grid, &start, |e, index, _| {
             node[e] = index as u32;
-            grad[e] = padded[in_padded[e]];
         });
         true
     }
