@@ -48,10 +48,12 @@ const ROUNDOFF: f64 = 64.0 * f64::EPSILON;
 ///
 /// **Stencil.** The nodes a with exp(-gamma |d_a|^2) >= tolerance, i.e. within the cut-off
 /// radius r = h sqrt(-ln(tolerance) / gamma). Along each axis they lie among the
-/// floor(2 r / h) + 1 nodes from x - r on, so the stencil is that block (shifted inwards at the
-/// grid's ends); the selected nodes come first, the block's other entries carry zero weight and
-/// gradient. Nodes outside the grid do not exist, so near a boundary the weights live on the
-/// grid's nodes alone and keep the convex-hull property.
+/// floor(2 r / h) + 1 nodes from x - r on, the block that is searched (shifted inwards at the
+/// grid's ends). A stencil lists them in the block's order, then other nodes of the block with
+/// zero weight and gradient, as many as fill it to the most nodes any point can have within r
+/// (`most_within`): in 2D about pi r^2 / h^2 of the block's (2 r / h)^2. Nodes
+/// outside the grid do not exist, so near a boundary the weights live on the grid's nodes
+/// alone and keep the convex-hull property.
 ///
 /// **Boundary.** On a face of the grid x is on the boundary of the nodes' convex hull: the
 /// minimiser of log Z is at infinity, the limit weights are the LME of the face's nodes, and
@@ -67,8 +69,10 @@ pub struct LocalMaxEnt<const D: usize> {
     gamma: f64,
     /// The cut-off radius in units of h.
     radius: f64,
-    /// Nodes per axis of the stencil block.
+    /// Nodes per axis of the block searched for the stencil.
     per_axis: usize,
+    /// Entries of a stencil: the most nodes within the cut-off radius of any point.
+    per_point: usize,
     /// Largest Newton step |Delta mu|. The weights are a Gaussian centred at d = mu / (2 gamma),
     /// so the limit 2 gamma r / h moves the centre by at most the cut-off radius per step.
     max_step: f64,
@@ -182,6 +186,50 @@ fn surround_radius(dimension: usize) -> f64 {
     (1.0 + (dimension as f64 - 1.0) / 4.0).sqrt()
 }
 
+/// The most grid nodes within `radius` (in units of h) of any point in `dimension` (1 or 2)
+/// dimensions: the entries a stencil needs.
+///
+/// In 1D that is floor(2 radius) + 1. In 2D the count changes only where a node crosses the
+/// circle about the point, so as the point moves it is constant on the faces of the
+/// arrangement of circles of the radius about the nodes, and at a vertex of a face, where two
+/// circles cross, it is at least the face's (the test counts a node on the circle): the
+/// largest count is at a vertex. The circles about node 0 and about each node within twice
+/// the radius give every vertex up to a lattice translation. Counting within a margin over the
+/// radius covers the round-off of the selection test and of the vertices computed here.
+fn most_within(radius: f64, dimension: usize) -> usize {
+    const MARGIN: f64 = 1e-9;
+    let r = radius + MARGIN;
+    if dimension == 1 {
+        // Below MAX_STENCIL_NODES, so the cast is exact.
+        return (2.0 * r).floor() as usize + 1;
+    }
+    let reach = r.ceil() as i64 + 1;
+    let count = |x: f64, y: f64| {
+        let (x, y) = (x.rem_euclid(1.0), y.rem_euclid(1.0));
+        let near = -reach..=reach + 1;
+        near.clone()
+            .flat_map(|i| near.clone().map(move |j| (i, j)))
+            .filter(|&(i, j)| (x - i as f64).powi(2) + (y - j as f64).powi(2) <= r * r)
+            .count()
+    };
+    let others = -2 * reach..=2 * reach;
+    others
+        .clone()
+        .flat_map(|i| others.clone().map(move |j| (i as f64, j as f64)))
+        .filter(|&(i, j)| {
+            let apart = i * i + j * j;
+            apart > 0.0 && apart <= 4.0 * radius * radius
+        })
+        .flat_map(|(i, j)| {
+            // The circles about (0, 0) and (i, j) cross on the perpendicular bisector.
+            let apart = (i * i + j * j).sqrt();
+            let along = (radius * radius - 0.25 * apart * apart).max(0.0).sqrt() / apart;
+            [1.0, -1.0].map(|side| count(0.5 * i - side * along * j, 0.5 * j + side * along * i))
+        })
+        .max()
+        .unwrap_or(1)
+}
+
 impl<const D: usize> LocalMaxEnt<D> {
     /// The basis with the default cut-off tolerance.
     pub fn new(gamma: f64) -> Result<Self, LmeParamError> {
@@ -217,6 +265,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             radius,
             // At most MAX_STENCIL_NODES, so the cast is exact.
             per_axis: side as usize,
+            per_point: most_within(radius, D).min(nodes as usize),
             max_step: 2.0 * gamma * radius,
             max_iterations: MAX_ITERATIONS,
             failures: AtomicUsize::new(0),
@@ -315,30 +364,57 @@ impl<const D: usize> LocalMaxEnt<D> {
         let s = (x - grid.lower) * grid.inv_h();
         let start = block_from(grid, &s.add_scalar(-self.radius), self.per_axis);
         // The selected nodes go first, their offsets d_a held in `grad` until the gradients
-        // replace them; the others fill the stencil from the back.
+        // replace them (their weights are the solver's to fill). Nodes of the block that are
+        // not selected fill the stencil from the back with zero weight and gradient, while
+        // there is room; a selected node found later may take the slot back. At the end the
+        // stencil lists each node once, the selected ones first.
         let radius_squared = self.radius * self.radius;
-        let mut selected = 0;
-        let mut unused = node.len();
+        let (mut selected, mut unused) = (0, node.len());
         // Row by row along the first axis, so that only a row's first node needs `block_node`.
         let stride = grid.stride(0);
-        for row in (0..node.len()).step_by(self.per_axis) {
-            let (first, mut local) = block_node(grid, &start, self.per_axis, row);
+        let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
+        for row in (0..self.per_axis.pow(D as u32)).step_by(self.per_axis) {
+            let (first, local) = block_node(grid, &start, self.per_axis, row);
             let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
             let first = first - start[0].min(grid.cells) * stride;
-            for along in 0..self.per_axis {
-                local[0] = along;
-                let index = first + (start[0] + along).min(grid.cells) * stride;
-                let on_grid = row_on_grid && start[0] + along <= grid.cells;
-                let d = SVector::<f64, D>::from_fn(|k, _| s[k] - (start[k] + local[k]) as f64);
-                // Without branches, which the cut-off's circle makes unpredictable: a selected
-                // node's weight is the solver's to overwrite.
-                let keep = on_grid & (d.norm_squared() <= radius_squared);
-                let slot = if keep { selected } else { unused - 1 };
-                node[slot] = index as u32;
-                weight[slot] = 0.0;
-                grad[slot] = if keep { d } else { SVector::zeros() };
-                selected += usize::from(keep);
-                unused -= usize::from(!keep);
+            let index = |along: usize| (first + (start[0] + along).min(grid.cells) * stride) as u32;
+            // The offsets d_a along the other axes are the row's; i64's conversion to f64 is
+            // one instruction, usize's several.
+            let across = SVector::<f64, D>::from_fn(|k, _| {
+                if k == 0 {
+                    0.0
+                } else {
+                    s[k] - (start[k] + local[k]) as i64 as f64
+                }
+            });
+            let offset = |along: usize| {
+                let mut d = across;
+                d[0] = s[0] - (start[0] + along) as i64 as f64;
+                d
+            };
+            let within = |along: usize| offset(along).norm_squared() <= radius_squared;
+            // The row's selected nodes are a run lo..hi: the distance falls, then rises,
+            // along it, and the nodes on the grid are a run from its start.
+            let (mut lo, mut hi) = (0, if row_on_grid { on_grid_along } else { 0 });
+            while lo < hi && !within(lo) {
+                lo += 1;
+            }
+            while hi > lo && !within(hi - 1) {
+                hi -= 1;
+            }
+            for along in (0..lo).chain(hi..self.per_axis) {
+                if unused <= selected {
+                    break;
+                }
+                unused -= 1;
+                node[unused] = index(along);
+                weight[unused] = 0.0;
+                grad[unused] = SVector::zeros();
+            }
+            for along in lo..hi {
+                node[selected] = index(along);
+                grad[selected] = offset(along);
+                selected += 1;
             }
         }
         let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
@@ -494,12 +570,18 @@ impl Exponentials {
             *p /= self.z;
             r += d * *p;
         }
-        // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation.
-        let mut j = SMatrix::zeros();
+        // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation,
+        // summed in its lower triangle: c_k c_l = c_l c_k, so the upper one is the same.
+        let mut j = SMatrix::<f64, D, D>::zeros();
         for (p, d) in weight.iter().zip(offsets) {
             let c = d - r;
-            j += c * c.transpose() * *p;
+            for l in 0..D {
+                for k in l..D {
+                    j[(k, l)] += c[k] * c[l] * *p;
+                }
+            }
         }
+        j.fill_upper_triangle_with_lower_triangle();
         Moments {
             log_z: self.log_z(),
             r,
@@ -510,7 +592,7 @@ impl Exponentials {
 
 impl<const D: usize> Shape<D> for LocalMaxEnt<D> {
     fn nodes_per_point(&self) -> usize {
-        self.per_axis.pow(D as u32)
+        self.per_point
     }
 
     fn eval(
