@@ -110,17 +110,17 @@ impl LineSums {
         let p = self.per_axis;
         // M_1^-1 L M_0^-1 r into `first`.
         first.copy_from_slice(r);
-        self.along[0].solve(first);
+        self.along[0].solve_blocks(first, p);
         scale(first, &self.lumped);
         transpose(p, first, transposed);
-        self.along[1].solve(transposed);
+        self.along[1].solve_blocks(transposed, p);
         transpose(p, transposed, first);
         // M_0^-1 L M_1^-1 r into `second`.
         transpose(p, r, transposed);
-        self.along[1].solve(transposed);
+        self.along[1].solve_blocks(transposed, p);
         transpose(p, transposed, second);
         scale(second, &self.lumped);
-        self.along[0].solve(second);
+        self.along[0].solve_blocks(second, p);
         for ((z, a), b) in z.iter_mut().zip(first.iter()).zip(second.iter()) {
             *z = 0.5 * (a + b);
         }
