@@ -285,7 +285,7 @@ impl<const D: usize> Reconstructor<D> {
                     if basis.rank() < T {
                         stats.rank_deficient += 1;
                     }
-                    basis.shape_coefficients()
+                    basis.shape_coefficients::<T>()
                 }
             };
             c.copy_from_slice(&solved[..T]);

@@ -108,22 +108,25 @@ impl OrthogonalBasis {
     }
 
     /// c of phi_p = w_p q_p . c: u^h = sum_i p_i(x) <p_i, u>/<p_i, p_i> (eq 11, 13) with
-    /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point.
+    /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point. `N` is
+    /// the basis size, `terms`.
     #[inline]
-    pub fn shape_coefficients(&self) -> [f64; MAX_TERMS] {
+    pub fn shape_coefficients<const N: usize>(&self) -> [f64; MAX_TERMS] {
         let mut first = [0.0; MAX_TERMS];
         first[0] = 1.0;
-        self.solve(&first)
+        self.solve::<f64, N>(&first)
     }
 
     /// The least-squares coefficients c of sum_j c_j q_j from rhs_j = <q_j, u>:
     /// c = sum_i p_i <p_i, u>/<p_i, p_i> over the kept polynomials (the pseudo-inverse of the
     /// moment matrix applied to rhs), with <p_i, u> = sum_j coeffs[i][j] rhs_j. The data may be
-    /// several fields at once (`Fitted`), each solved with a scalar's arithmetic.
+    /// several fields at once (`Fitted`), each solved with a scalar's arithmetic. `N` is the
+    /// basis size, `terms`, as a constant so that the loops unroll.
     #[inline]
-    pub fn solve<T: Fitted>(&self, rhs: &[T; MAX_TERMS]) -> [T; MAX_TERMS] {
+    pub fn solve<T: Fitted, const N: usize>(&self, rhs: &[T; MAX_TERMS]) -> [T; MAX_TERMS] {
+        debug_assert_eq!(N, self.terms);
         let mut out = [T::splat(0.0); MAX_TERMS];
-        for i in 0..self.terms {
+        for i in 0..N {
             if !self.kept[i] {
                 continue;
             }

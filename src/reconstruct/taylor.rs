@@ -270,7 +270,7 @@ impl<const D: usize> TaylorFit<D> {
                     rhs[j] += r * psi[j];
                 }
             }
-            let correction = self.basis.solve(&rhs);
+            let correction = self.basis.solve::<T, F>(&rhs);
             for j in 0..F {
                 c[j] += correction[j];
             }

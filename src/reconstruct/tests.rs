@@ -214,7 +214,7 @@ fn two_points_make_the_quadratic_polynomial_vanish() {
         );
     }
     // u = 2 - 3x at the points; the degraded fit evaluated at 0 gives u(0) = 2.
-    let c = basis.shape_coefficients();
+    let c = basis.shape_coefficients::<3>();
     let u0: f64 = xs
         .iter()
         .map(|&x| {
