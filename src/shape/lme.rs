@@ -194,8 +194,10 @@ fn surround_radius(dimension: usize) -> f64 {
 /// arrangement of circles of the radius about the nodes, and at a vertex of a face, where two
 /// circles cross, it is at least the face's (the test counts a node on the circle): the
 /// largest count is at a vertex. The circles about node 0 and about each node within twice
-/// the radius give every vertex up to a lattice translation. Counting within a margin over the
-/// radius covers the round-off of the selection test and of the vertices computed here.
+/// the radius give every vertex up to a lattice translation, and the nodes (i, j) with
+/// 0 <= j <= i every vertex up to the lattice's reflections as well, which keep the count.
+/// Counting within a margin over the radius covers the round-off of the selection test and of
+/// the vertices computed here.
 fn most_within(radius: f64, dimension: usize) -> usize {
     const MARGIN: f64 = 1e-9;
     let r = radius + MARGIN;
@@ -212,10 +214,8 @@ fn most_within(radius: f64, dimension: usize) -> usize {
             .filter(|&(i, j)| (x - i as f64).powi(2) + (y - j as f64).powi(2) <= r * r)
             .count()
     };
-    let others = -2 * reach..=2 * reach;
-    others
-        .clone()
-        .flat_map(|i| others.clone().map(move |j| (i as f64, j as f64)))
+    (0..=2 * reach)
+        .flat_map(|i| (0..=i).map(move |j| (i as f64, j as f64)))
         .filter(|&(i, j)| {
             let apart = i * i + j * j;
             apart > 0.0 && apart <= 4.0 * radius * radius
