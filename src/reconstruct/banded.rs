@@ -124,8 +124,9 @@ impl BandMatrix {
     /// unroll.
     fn solve_blocks_with<const B: usize>(&self, rhs: &mut [f64], block: usize) {
         debug_assert_eq!(self.bandwidth, B);
-        debug_assert_eq!(self.n % block.max(1), 0);
-        let blocks = self.n / block.max(1);
+        debug_assert!(block > 0 && self.n.is_multiple_of(block));
+        // An empty matrix has no blocks, whatever `block` says.
+        let blocks = self.n.checked_div(block).unwrap_or(0);
         // L_(j+t)j = band[j (B + 1) + B + t B], as `at` places it; t = 0 is the diagonal.
         let entry = |j: usize, t: usize| self.band[j * (B + 1) + B + t * B];
         for group in (0..blocks).step_by(LANES) {

@@ -28,8 +28,9 @@ pub const MAX_ITERATIONS: usize = 100;
 /// Newton stops when |r| < RESIDUAL_TOLERANCE h, i.e. when sum_a p_a x_a reproduces x to that.
 pub const RESIDUAL_TOLERANCE: f64 = 1e-12;
 
-/// Most nodes in the stencil block of one point. Every particle holds its block's nodes,
-/// weights and gradients, so this bounds the memory of the basis: 1024 (32 x 32 in 2D) takes
+/// Most nodes in the stencil block of one point. Every particle holds up to that many nodes,
+/// weights and gradients (those within the radius of some point), so this bounds the memory
+/// of the basis: 1024 (32 x 32 in 2D) takes
 /// gamma down to 0.054 in 2D and 5.3e-5 in 1D at the default tolerance, where the committed
 /// studies need at most 196 (gamma 0.3 in 2D).
 pub const MAX_STENCIL_NODES: usize = 1024;
