@@ -50,6 +50,19 @@ impl BandMatrix {
         self.band[k] += value;
     }
 
+    /// Adds `value` to entry (i, i - offset) and, by symmetry, (i - offset, i), for an offset
+    /// of either sign within the band.
+    #[inline]
+    pub fn add_offset(&mut self, i: usize, offset: isize, value: f64) {
+        let row = if offset < 0 {
+            i + offset.unsigned_abs()
+        } else {
+            i
+        };
+        let k = row * (self.bandwidth + 1) + self.bandwidth - offset.unsigned_abs();
+        self.band[k] += value;
+    }
+
     /// Overwrites the matrix with its Cholesky factor L (A = L L^T), in place. Right-looking:
     /// once column k of L is known it is subtracted from the trailing block, so every entry
     /// receives its terms L_ik L_jk in ascending k, as the dot products of the textbook

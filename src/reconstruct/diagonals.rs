@@ -76,13 +76,14 @@ impl SymmetricDiagonals {
         }
     }
 
-    /// Calls `visit(i, j, a_ij)` for every stored entry of the lower triangle (j <= i).
-    pub fn for_each_lower(&self, mut visit: impl FnMut(usize, usize, f64)) {
-        for (s, &d) in self.distances.iter().enumerate() {
-            for i in d..self.n {
-                visit(i, i - d, self.values[s * self.n + i]);
-            }
-        }
+    /// The stored diagonals of the lower triangle in the order of `distances`: each distance d
+    /// with its values, A[i][i - d] at index i (zero for i < d).
+    pub fn diagonals(&self) -> impl Iterator<Item = (usize, &[f64])> {
+        let n = self.n.max(1);
+        self.distances
+            .iter()
+            .copied()
+            .zip(self.values.chunks_exact(n))
     }
 
     /// y = A x.

@@ -18,8 +18,7 @@ pub struct LineSums {
     along: [BandMatrix; 2],
     /// Row sums of M over the DOFs solved for, zero elsewhere.
     lumped: Vec<f64>,
-    /// Per DOF its lattice coordinates, and whether it is solved for.
-    coords: Vec<[usize; 2]>,
+    /// Per DOF whether it is solved for.
     solved: Vec<bool>,
     scratch: [Vec<f64>; 3],
 }
@@ -47,23 +46,20 @@ impl LineSums {
         if matrix.distances().iter().all(|d| neighbours.contains(d)) {
             return Ok(false);
         }
-        if self.per_axis != p || self.coords.len() != n {
-            self.per_axis = p;
-            self.coords = (0..n).map(|i| [i % p, i / p]).collect();
-        }
+        self.per_axis = p;
         self.solved.clear();
         self.solved.extend((0..n).map(&solved));
-        let (coords, solved) = (&self.coords, &self.solved);
+        let solved = &self.solved;
         // A stored diagonal also holds the zeros between DOFs of distant lines.
-        let coupled = |i: usize, j: usize, value: f64| value != 0.0 && solved[i] && solved[j];
+        let coupled = |i: usize, value: f64, d: usize| value != 0.0 && solved[i] && solved[i - d];
         let mut band = [0; 2];
-        matrix.for_each_lower(|i, j, value| {
-            if coupled(i, j, value) {
-                for (b, (ci, cj)) in band.iter_mut().zip(coords[i].iter().zip(&coords[j])) {
-                    *b = (*b).max(ci.abs_diff(*cj));
-                }
+        for (d, diagonal) in matrix.diagonals() {
+            if (d..n).any(|i| coupled(i, diagonal[i], d)) {
+                let step = LatticeStep::of(d, p);
+                band[0] = band[0].max(step.along_0.unsigned_abs());
+                band[1] = band[1].max(step.along_1);
             }
-        });
+        }
         if band.iter().all(|&b| b <= 1) {
             return Ok(false);
         }
@@ -74,26 +70,34 @@ impl LineSums {
         self.lumped.resize(n, 0.0);
         let [along_0, along_1] = &mut self.along;
         let lumped = &mut self.lumped;
-        matrix.for_each_lower(|i, j, value| {
-            if !coupled(i, j, value) {
-                return;
+        for (d, diagonal) in matrix.diagonals() {
+            let step = LatticeStep::of(d, p);
+            let (dx, dy) = (step.along_0, step.along_1 as isize);
+            // The diagonal's pairs (i, j = i - d), each with its transposed numbers.
+            let half = |offset: isize, value: f64| if offset == 0 { value } else { 0.5 * value };
+            let pairs = (d..n).map(|i| (i, i - d)).zip(transposed_pairs(d, p, step));
+            for ((i, j), (ti, tj)) in pairs {
+                let value = diagonal[i];
+                if !coupled(i, value, d) {
+                    continue;
+                }
+                debug_assert_eq!(LatticeStep::between(i, j, p), step);
+                // Row i's coupling to j lands on i's line at j's position along it, and row
+                // j's on j's line at i's position; in transposed numbering for axis 1.
+                along_0.add_offset(i, dx, half(dx, value));
+                along_1.add_offset(ti, dy, half(dy, value));
+                lumped[i] += value;
+                if d != 0 {
+                    along_0.add_offset(j, -dx, half(dx, value));
+                    along_1.add_offset(tj, -dy, half(dy, value));
+                    lumped[j] += value;
+                }
             }
-            let ([ix, iy], [jx, jy]) = (coords[i], coords[j]);
-            // Row i's coupling to j lands on i's line at j's position along it, and row j's
-            // on j's line at i's position; in transposed numbering for axis 1.
-            add_directed(along_0, i, jx + p * iy, value);
-            add_directed(along_1, iy + p * ix, jy + p * ix, value);
-            lumped[i] += value;
-            if i != j {
-                add_directed(along_0, j, ix + p * jy, value);
-                add_directed(along_1, jy + p * jx, iy + p * jx, value);
-                lumped[j] += value;
-            }
-        });
+        }
         for i in (0..n).filter(|&i| !solved[i]) {
-            let [ix, iy] = coords[i];
+            let t = transposed(i, p);
             along_0.add(i, i, 1.0);
-            along_1.add(iy + p * ix, iy + p * ix, 1.0);
+            along_1.add(t, t, 1.0);
         }
         along_0.factor()?;
         along_1.factor()?;
@@ -127,10 +131,54 @@ impl LineSums {
     }
 }
 
-/// Adds the entry (i, j) of a matrix that is not symmetric to the symmetric `band` as its
-/// symmetric part: half to (i, j) and half to (j, i).
-fn add_directed(band: &mut BandMatrix, i: usize, j: usize, value: f64) {
-    band.add(i, j, if i == j { value } else { 0.5 * value });
+/// The lattice step from DOF j to DOF i = j + d of a stored diagonal d: `along_0` on the first
+/// axis (of either sign) and `along_1` on the second. A stencil is a box of a few nodes per axis
+/// that never wraps from one end of a grid row to the next, so every coupled pair of a
+/// diagonal is the same step, the one with |along_0| under half a row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LatticeStep {
+    along_0: isize,
+    along_1: usize,
+}
+
+impl LatticeStep {
+    fn of(d: usize, p: usize) -> Self {
+        let along_1 = (d + p / 2) / p;
+        LatticeStep {
+            along_0: d as isize - (p * along_1) as isize,
+            along_1,
+        }
+    }
+
+    fn between(i: usize, j: usize, p: usize) -> Self {
+        LatticeStep {
+            along_0: (i % p) as isize - (j % p) as isize,
+            along_1: i / p - j / p,
+        }
+    }
+}
+
+/// DOF i's number with the axes swapped (second axis fastest).
+fn transposed(i: usize, p: usize) -> usize {
+    i / p + p * (i % p)
+}
+
+/// For i = d, d + 1, ... the transposed numbers of i and of j = i - d, counted along: t_i
+/// steps by p within a row of the lattice and starts the next row at its index; t_j is t_i
+/// less the transposed step, valid where (i, j) is the diagonal's lattice step.
+fn transposed_pairs(d: usize, p: usize, step: LatticeStep) -> impl Iterator<Item = (usize, usize)> {
+    let back = step.along_1 as isize + p as isize * step.along_0;
+    let (mut x, mut t) = (d % p, transposed(d, p));
+    std::iter::from_fn(move || {
+        let pair = (t, t.wrapping_add_signed(-back));
+        x += 1;
+        t += p;
+        if x == p {
+            x = 0;
+            t = t + 1 - p * p;
+        }
+        Some(pair)
+    })
 }
 
 fn scale(x: &mut [f64], by: &[f64]) {
@@ -228,6 +276,22 @@ mod tests {
         let kept = (0..n).filter(|&i| solved(i)).count();
         assert_eq!(eigenvalues.iter().filter(|&&l| l > 1e-12).count(), kept);
         assert!(eigenvalues.iter().all(|&l| l > -1e-12));
+    }
+
+    /// The transposed numbers counted along a diagonal are those of i and i - d wherever the
+    /// pair is the diagonal's lattice step.
+    #[test]
+    fn counts_the_transposed_numbers_along_a_diagonal() {
+        let p = 7;
+        for d in 0..3 * p {
+            let step = LatticeStep::of(d, p);
+            for (i, (ti, tj)) in (d..p * p).zip(transposed_pairs(d, p, step)) {
+                assert_eq!(ti, transposed(i, p));
+                if LatticeStep::between(i, i - d, p) == step {
+                    assert_eq!(tj, transposed(i - d, p), "d {d}, i {i}");
+                }
+            }
+        }
     }
 
     /// A matrix whose DOFs couple only to their neighbours along each axis (the hat's) gets
