@@ -12,7 +12,7 @@ use num_traits::Zero;
 use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
-use super::solve::{add_weighted_outer, mls_coefficients, OrthogonalBasis};
+use super::solve::{mls_coefficients, Moments, OrthogonalBasis};
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,7 +107,7 @@ pub struct Reconstructor<const D: usize> {
     offset: Vec<SVector<f64, D>>,
     /// The weight w(x_e - x_p) after pass one, the shape function phi_p(x_e) after the fit.
     phi: Vec<f64>,
-    /// Per evaluation point, the row-major terms x terms moment matrix, then c_e.
+    /// Per evaluation point, its moment matrix packed as `packed_len` describes.
     moments: Vec<f64>,
     coeffs: Vec<f64>,
     covered: Vec<bool>,
@@ -132,7 +132,7 @@ impl<const D: usize> Reconstructor<D> {
             point: Vec::new(),
             offset: Vec::new(),
             phi: Vec::new(),
-            moments: vec![0.0; points * terms * terms],
+            moments: vec![0.0; points * packed_len(terms)],
             coeffs: vec![0.0; points * terms],
             covered: vec![false; points],
             lattice,
@@ -155,32 +155,32 @@ impl<const D: usize> Reconstructor<D> {
     /// Builds the shape functions for particles at `x`. Points no particle reaches get
     /// zero shape functions and are not counted.
     pub fn fit(&mut self, x: &[SVector<f64, D>]) -> Result<FitStats, SingularMoments> {
-        // The basis size (and the moment matrix's, `TT` = T^2) as constants lets the
+        // The basis size (and the packed moment matrix's, `P`) as constants lets the
         // per-entry loops over terms unroll and a point's matrix be indexed as one array.
         match self.terms {
             1 => self.fit_with::<1, 1>(x),
-            2 => self.fit_with::<2, 4>(x),
-            3 => self.fit_with::<3, 9>(x),
-            MAX_TERMS => self.fit_with::<MAX_TERMS, { MAX_TERMS * MAX_TERMS }>(x),
+            2 => self.fit_with::<2, { packed_len(2) }>(x),
+            3 => self.fit_with::<3, { packed_len(3) }>(x),
+            MAX_TERMS => self.fit_with::<MAX_TERMS, { packed_len(MAX_TERMS) }>(x),
             t => unreachable!("no basis has {t} terms"),
         }
     }
 
-    fn fit_with<const T: usize, const TT: usize>(
+    fn fit_with<const T: usize, const P: usize>(
         &mut self,
         x: &[SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
-        debug_assert_eq!(TT, T * T);
-        self.gather_weights::<T, TT>(x);
-        let stats = self.solve::<T>()?;
+        debug_assert_eq!(P, packed_len(T));
+        self.gather_weights::<T, P>(x);
+        let stats = self.solve::<T, P>()?;
         self.finish_shape_functions::<T>();
         Ok(stats)
     }
 
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
     /// the moment matrices, summed particle by particle in order.
-    fn gather_weights<const T: usize, const TT: usize>(&mut self, x: &[SVector<f64, D>]) {
+    fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) {
         // Sized for the most entries once; indexed writes are cheaper than pushes.
         let capacity = x.len() * self.max_entries;
         self.point.resize(capacity, 0);
@@ -191,7 +191,7 @@ impl<const D: usize> Reconstructor<D> {
         // Borrowed apart so the loop keeps them in registers.
         let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
         let (point, offset, phi) = (&mut self.point[..], &mut self.offset[..], &mut self.phi[..]);
-        let (start, moments) = (&mut self.start[..], self.moments.as_chunks_mut::<TT>().0);
+        let (start, moments) = (&mut self.start[..], self.moments.as_chunks_mut::<P>().0);
         let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
         // Per axis and neighbour: the part of the lattice index, the offset and the 1D
         // weight factor, so each entry only combines them.
@@ -246,7 +246,7 @@ impl<const D: usize> Reconstructor<D> {
                         *d_out = d;
                         *w_out = w;
                         monomials(degree, &d, &mut q);
-                        add_weighted_outer(&mut moments[e_full], T, w, &q[..T]);
+                        add_moments::<T, P>(&mut moments[e_full], w, &q);
                     }
                     // The next row: an odometer over the axes after the first.
                     for k in 1..D {
@@ -264,10 +264,12 @@ impl<const D: usize> Reconstructor<D> {
     }
 
     /// The coefficients c_e at every evaluation point.
-    fn solve<const T: usize>(&mut self) -> Result<FitStats, SingularMoments> {
+    fn solve<const T: usize, const P: usize>(&mut self) -> Result<FitStats, SingularMoments> {
         let mut stats = FitStats::default();
-        for e in 0..self.lattice.len() {
-            let a = &self.moments[e * T * T..][..T * T];
+        let packed = self.moments.as_chunks::<P>().0;
+        for (e, packed) in packed.iter().enumerate() {
+            let a = unpack::<T, P>(packed);
+            let a = &a[..];
             let c = &mut self.coeffs[e * T..][..T];
             self.covered[e] = a[0] > 0.0;
             if !self.covered[e] {
@@ -276,12 +278,14 @@ impl<const D: usize> Reconstructor<D> {
             }
             stats.fits += 1;
             let solved = match self.recipe.solver {
-                Solver::Mls => mls_coefficients(a, T, T).ok_or_else(|| SingularMoments {
-                    point: e,
-                    position: self.lattice.point(e).iter().copied().collect(),
-                })?,
+                Solver::Mls => {
+                    mls_coefficients(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
+                        point: e,
+                        position: self.lattice.point(e).iter().copied().collect(),
+                    })?
+                }
                 Solver::Imls => {
-                    let basis = OrthogonalBasis::from_rows(a, T, T);
+                    let basis = OrthogonalBasis::from_rows(a, MAX_TERMS, T);
                     if basis.rank() < T {
                         stats.rank_deficient += 1;
                     }
@@ -331,4 +335,40 @@ impl<const D: usize> Reconstructor<D> {
             }
         }
     }
+}
+
+/// A moment matrix A = sum w q q^T packed for summing: row 0, then rows 1.. without their
+/// first entry, row-major. The monomials start with q_0 = 1, so entry (r, 0) would receive
+/// (w q_r) 1 = w q_r, the bits that (0, r) receives as (w 1) q_r: column 0 below row 0 is
+/// row 0's copy, and leaving it out keeps each datum's sums to the entries that differ.
+const fn packed_len(terms: usize) -> usize {
+    terms + (terms - 1) * (terms - 1)
+}
+
+/// a += w q q^T, packed.
+#[inline(always)]
+fn add_moments<const T: usize, const P: usize>(a: &mut [f64; P], w: f64, q: &[f64; MAX_TERMS]) {
+    debug_assert_eq!(q[0], 1.0);
+    let wq: [f64; T] = std::array::from_fn(|r| w * q[r]);
+    for s in 0..T {
+        a[s] += wq[0] * q[s];
+    }
+    for r in 1..T {
+        for s in 1..T {
+            a[T + (r - 1) * (T - 1) + s - 1] += wq[r] * q[s];
+        }
+    }
+}
+
+/// The row-major matrix of packed moments, row length `MAX_TERMS`.
+#[inline(always)]
+fn unpack<const T: usize, const P: usize>(packed: &[f64; P]) -> Moments {
+    let mut a = [0.0; MAX_TERMS * MAX_TERMS];
+    a[..T].copy_from_slice(&packed[..T]);
+    for r in 1..T {
+        a[r * MAX_TERMS] = packed[r];
+        let row = &packed[T + (r - 1) * (T - 1)..][..T - 1];
+        a[r * MAX_TERMS + 1..][..T - 1].copy_from_slice(row);
+    }
+    a
 }
