@@ -107,7 +107,7 @@ pub struct Reconstructor<const D: usize> {
     offset: Vec<SVector<f64, D>>,
     /// The weight w(x_e - x_p) after pass one, the shape function phi_p(x_e) after the fit.
     phi: Vec<f64>,
-    /// Per evaluation point, its moment matrix packed as `packed_len` describes.
+    /// Per evaluation point, its moment matrix packed as `packed_len` describes, then its c_e.
     moments: Vec<f64>,
     coeffs: Vec<f64>,
     covered: Vec<bool>,
