@@ -227,10 +227,10 @@ mod tests {
     }
 
     /// On a block-diagonal band matrix (blocks of 9 rows, 1 to 2 LANES of them and a
-    /// remainder) the block solve gives `solve`'s numbers to the last bit.
+    /// remainder; blocks as short as the band or shorter, with no interior rows) the block
+    /// solve gives `solve`'s numbers to the last bit.
     #[test]
     fn block_solve_matches_the_solve() {
-        // Blocks of 9 rows, and blocks as short as the band or shorter (no interior rows).
         let cases = [
             (1, 2, 9),
             (3, 1, 9),
