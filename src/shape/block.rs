@@ -58,29 +58,22 @@ pub fn block_from<const D: usize>(
     std::array::from_fn(|k| (lo[k].ceil().max(0.0) as usize).min(last_start))
 }
 
-/// Node index of entry `e` of a stencil block of `per_axis` nodes per axis starting at `start`,
-/// and its coordinates within the block: the block's first axis runs fastest. Entries past the
-/// grid (grids with fewer than `per_axis - 1` cells) repeat the last node and must carry zero
-/// weight.
-pub fn block_node<const D: usize>(
+/// Node index of the entry at coordinates `local` of a stencil block starting at `start`.
+/// Entries past the grid (grids with fewer than `per_axis - 1` cells) repeat the last node
+/// and must carry zero weight.
+#[inline]
+pub fn block_node_at<const D: usize>(
     grid: &Grid<D>,
     start: &[usize; D],
-    per_axis: usize,
-    e: usize,
-) -> (usize, [usize; D]) {
-    let mut index = 0;
-    let mut local = [0; D];
-    let mut rest = e;
-    for k in 0..D {
-        local[k] = rest % per_axis;
-        rest /= per_axis;
-        index += (start[k] + local[k]).min(grid.cells) * grid.stride(k);
-    }
-    (index, local)
+    local: &[usize; D],
+) -> usize {
+    (0..D)
+        .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
+        .sum()
 }
 
 /// Calls `visit(e, index, local)` for the entries `e = 0, 1, ...` of a block of `A` nodes per
-/// axis starting at `start`: what `block_node` gives for each, from per-axis tables of the
+/// axis starting at `start`: what `block_node_at` gives for each, from per-axis tables of the
 /// nodes' index terms and counted up axis by axis instead of divided out, as the per-particle
 /// stencils need it for every entry.
 #[inline]

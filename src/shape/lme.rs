@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{SMatrix, SVector};
 
-use super::block::{block_from, block_node};
+use super::block::{block_from, block_node_at};
 use super::{Dofs, Grid, Shape, Stencils};
 
 /// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
@@ -371,11 +371,14 @@ impl<const D: usize> LocalMaxEnt<D> {
         // stencil lists each node once, the selected ones first.
         let radius_squared = self.radius * self.radius;
         let (mut selected, mut unused) = (0, node.len());
-        // Row by row along the first axis, so that only a row's first node needs `block_node`.
+        // Row by row along the first axis, so that only a row's first node needs
+        // `block_node_at`; the rows' coordinates counted up, not divided out of an index
+        // (perf's cycle samples sat on the two integer divisions per row).
         let stride = grid.stride(0);
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
-        for row in (0..self.per_axis.pow(D as u32)).step_by(self.per_axis) {
-            let (first, local) = block_node(grid, &start, self.per_axis, row);
+        let mut local = [0; D];
+        for _ in 0..self.per_axis.pow(D as u32 - 1) {
+            let first = block_node_at(grid, &start, &local);
             let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
             let first = first - start[0].min(grid.cells) * stride;
             let index = |along: usize| (first + (start[0] + along).min(grid.cells) * stride) as u32;
@@ -416,6 +419,14 @@ impl<const D: usize> LocalMaxEnt<D> {
                 node[selected] = index(along);
                 grad[selected] = offset(along);
                 selected += 1;
+            }
+            // The next row: an odometer over the axes after the first.
+            for k in 1..D {
+                local[k] += 1;
+                if local[k] < self.per_axis {
+                    break;
+                }
+                local[k] = 0;
             }
         }
         let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
