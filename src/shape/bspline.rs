@@ -90,7 +90,7 @@ impl<const D: usize> Shape<D> for QuadraticBSpline {
             node[e] = index as u32;
             weight[e] = w;
             grad[e] = g;
-            next_block_entry::<D, PER_AXIS>(&mut locals);
+            next_block_entry(&mut locals, PER_AXIS);
         }
         true
     }

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{SMatrix, SVector};
 
-use super::block::{block_from, block_node_at};
+use super::block::{block_from, next_block_entry};
 use super::{Dofs, Grid, Shape, Stencils};
 
 /// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
@@ -371,16 +371,17 @@ impl<const D: usize> LocalMaxEnt<D> {
         // stencil lists each node once, the selected ones first.
         let radius_squared = self.radius * self.radius;
         let (mut selected, mut unused) = (0, node.len());
-        // Row by row along the first axis, so that only a row's first node needs
-        // `block_node_at`; the rows' coordinates counted up, not divided out of an index
+        // Row by row along the first axis, so that the other axes' part of the node index is
+        // taken once a row; the rows' coordinates counted up, not divided out of an index
         // (perf's cycle samples sat on the two integer divisions per row).
         let stride = grid.stride(0);
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
         let mut local = [0; D];
         for _ in 0..self.per_axis.pow(D as u32 - 1) {
-            let first = block_node_at(grid, &start, &local);
             let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
-            let first = first - start[0].min(grid.cells) * stride;
+            let first: usize = (1..D)
+                .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
+                .sum();
             let index = |along: usize| (first + (start[0] + along).min(grid.cells) * stride) as u32;
             // The offsets d_a along the other axes are the row's; i64's conversion to f64 is
             // one instruction, usize's several.
@@ -420,14 +421,7 @@ impl<const D: usize> LocalMaxEnt<D> {
                 grad[selected] = offset(along);
                 selected += 1;
             }
-            // The next row: an odometer over the axes after the first.
-            for k in 1..D {
-                local[k] += 1;
-                if local[k] < self.per_axis {
-                    break;
-                }
-                local[k] = 0;
-            }
+            next_block_entry(&mut local[1..], self.per_axis);
         }
         let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
         let cold = SVector::zeros();
