@@ -85,12 +85,16 @@ impl<const D: usize> Lattice<D> {
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
-        // Truncation is floor() here, from the point's cell down to the first cell, without a
-        // libm call; through i64, which converts in one instruction where usize does not.
-        let first_cell = ((s - radius - 1.0) as i64).max(0) as usize;
+        // A cell below s - radius - (its largest offset) holds no point within the radius:
+        // they lie a whole h further out than rounding can reach. Truncation is floor()
+        // here, from the point's cell down to the first cell, without a libm call; through
+        // i64, which converts in one instruction where usize does not.
+        let first_cell = ((s - radius - self.last_offset()) as i64).max(0) as usize;
         let last_cell = ((s + radius) as i64).max(0) as usize;
         let mut n = 0;
-        // Cells, then offsets within a cell: lattice index order without a division.
+        // Cells, then offsets within a cell: lattice index order without a division. The
+        // offsets d grow with the index (rounding is monotone), so the points within the
+        // radius are one run, and the first point at or past it ends the search.
         'cells: for cell in first_cell..=last_cell {
             for (j, &offset) in self.offsets.iter().enumerate() {
                 let i = cell * k + j;
@@ -98,13 +102,20 @@ impl<const D: usize> Lattice<D> {
                     break 'cells;
                 }
                 let d = (cell as f64 + offset) - s;
-                if d.abs() < radius {
+                if d >= radius {
+                    break 'cells;
+                }
+                if d > -radius {
                     out[n] = (i, d);
                     n += 1;
                 }
             }
         }
         n
+    }
+
+    fn last_offset(&self) -> f64 {
+        self.offsets[self.offsets.len() - 1]
     }
 
     /// An upper bound on `near_on_axis`'s count: an open interval of length 2 radius
@@ -214,6 +225,44 @@ mod tests {
                     }
                     for &(i, d) in &out[..n] {
                         assert!((d - (lattice.point(i)[0] - x) / g.h).abs() < 1e-12);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The pruned search returns what testing every lattice point returns, to the bit:
+    /// the same points, in index order, with the same offsets.
+    #[test]
+    fn near_on_axis_matches_testing_every_point() {
+        let g = grid::<1>(8);
+        let mut rng = crate::rng::Lcg::new(7);
+        for lattice in [
+            Lattice::nodes(&g),
+            Lattice::cell_centres(&g),
+            Lattice::gauss(&g, 2),
+            Lattice::gauss(&g, 3),
+        ] {
+            let k = lattice.offsets.len();
+            for radius in [0.5, 1.0, 1.5, 2.0, 3.0] {
+                let mut out = vec![(0, 0.0); lattice.max_per_axis(radius)];
+                for trial in 0..2000 {
+                    // Random points, and points on the lattice and the cell faces.
+                    let x = match trial % 3 {
+                        0 => -1.1 + 2.2 * rng.unit(),
+                        1 => lattice.point(trial % lattice.len())[0],
+                        _ => -1.0 + (trial % 9) as f64 * g.h,
+                    };
+                    let s = (x - lattice.lower[0]) / lattice.h;
+                    let every: Vec<(usize, f64)> = (0..lattice.len())
+                        .map(|i| (i, ((i / k) as f64 + lattice.offsets[i % k]) - s))
+                        .filter(|&(_, d)| d.abs() < radius)
+                        .collect();
+                    let n = lattice.near_on_axis(0, x, radius, &mut out);
+                    let found = &out[..n];
+                    assert_eq!(found.len(), every.len(), "x = {x}, radius {radius}");
+                    for (a, b) in found.iter().zip(&every) {
+                        assert_eq!((a.0, a.1.to_bits()), (b.0, b.1.to_bits()), "x = {x}");
                     }
                 }
             }

@@ -303,14 +303,14 @@ impl<const D: usize> Reconstructor<D> {
         let degree = degree_of::<T, D>();
         let entries = self.start.last().copied().unwrap_or(0);
         let phis = &mut self.phi[..entries];
-        let coeffs = &self.coeffs[..];
+        let coeffs = self.coeffs.as_chunks::<T>().0;
         for ((phi, &e), d) in phis.iter_mut().zip(&self.point).zip(&self.offset) {
             let w = *phi;
             if w == 0.0 {
                 continue;
             }
             monomials(degree, d, &mut q);
-            let c = &coeffs[e as usize * T..][..T];
+            let c = &coeffs[e as usize];
             *phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
         }
     }
