@@ -13,13 +13,16 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
-use mpmlab::benchmarks::{self, thesis_params, Domain};
-use mpmlab::experiment::RunSpec;
+use mpmlab::benchmarks::{self, thesis_params};
+
+use mpmlab::grid::Domain;
+use mpmlab::grid::Grid;
 use mpmlab::methods::{self, GAMMA_KEY, INTEGRATOR_KEY};
 use mpmlab::output::RunStatus;
 use mpmlab::params::{ParamValue, Params};
 use mpmlab::rng::Lcg;
-use mpmlab::shape::{Grid, LinearHat, LocalMaxEnt, Shape, Stencils};
+use mpmlab::run_spec::RunSpec;
+use mpmlab::shape::{LinearHat, LocalMaxEnt, Shape, Stencils};
 use mpmlab::solver::simulate;
 
 /// The system allocator, counting the bytes live and their peak since the last `reset`.

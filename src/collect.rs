@@ -12,12 +12,13 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 use crate::benchmarks::BenchmarkKind;
-use crate::experiment::{self, Experiment, RunSpec};
+use crate::experiment::{self, Experiment};
 use crate::experiment::{FigureKind, TableKind};
 use crate::output::{
     open_hdf5, open_run_file, read_final_state, read_probes, read_summary, run_path, ParticleState,
     RunSummary, UnreadableRun,
 };
+use crate::run_spec::RunSpec;
 use crate::runner::EXPERIMENT_COPY;
 
 pub struct Collected {

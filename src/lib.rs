@@ -1,16 +1,15 @@
 //! mpmlab: a research pipeline for the Material Point Method.
 //!
-//! Layers, top to bottom: `slurm` (a matrix as a Slurm job array), `shard` (splits a matrix
-//! for several machines), `experiment` (YAML, matrix), `runner` (runs a matrix in parallel),
-//! `output` (HDF5 layout), `report` (rates, tables, figures), `solver` (one run),
-//! `benchmarks`, `integrate`, `reconstruct`, `shape`, `material`. `linear_stability` holds
-//! the predicted stability bounds that `report` draws beside measured ones.
+//! The modules form layers, each importing only from those below it: `docs/ARCHITECTURE.md`
+//! orders them, and `tests/layers.rs` holds the code to that order.
 
 pub mod benchmarks;
 pub mod collect;
-
+pub mod divergence;
 pub mod experiment;
 pub mod fallible;
+pub mod gauss;
+pub mod grid;
 pub mod integrate;
 pub mod linear_stability;
 pub mod material;
@@ -24,6 +23,7 @@ pub mod reconstruction_methods;
 pub mod reference;
 pub mod report;
 pub mod rng;
+pub mod run_spec;
 pub mod runner;
 pub mod shape;
 pub mod shape_methods;

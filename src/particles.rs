@@ -2,11 +2,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::benchmarks::Problem;
 use crate::fallible::filled;
+use crate::gauss::gauss_legendre_rule;
+use crate::grid::{lattice_coords, Grid};
 use crate::parallel;
-use crate::reconstruct::gauss_legendre_rule;
-use crate::shape::{lattice_coords, Grid};
 
 /// State carried by the material points. Velocities are what the integrator steps: the
 /// leapfrog's half-step values v^{s-1/2} between steps (v^0 before the first), the whole-step
@@ -57,12 +56,26 @@ pub enum Placement {
     Gauss,
 }
 
+/// What seeding needs of a problem: the box of its body, how many points per cell and axis
+/// and where in the cell, and the initial density.
+#[derive(Clone, Copy, Debug)]
+pub struct Body<const D: usize> {
+    pub lower: SVector<f64, D>,
+    pub upper: SVector<f64, D>,
+    pub ppc: usize,
+    pub placement: Placement,
+    pub rho0: f64,
+}
+
 impl<const D: usize> Particles<D> {
-    /// `ppc^D` points per grid cell of the problem's body, where the problem's placement puts
-    /// them, numbered with the first axis fastest.
-    pub fn seed(problem: &dyn Problem<D>, grid: &Grid<D>) -> Self {
-        let (lo, hi) = problem.body();
-        let ppc = problem.ppc();
+    /// `ppc^D` points per grid cell of the body, where its placement puts them, numbered with
+    /// the first axis fastest, moving at `initial_velocity`.
+    pub fn seed(
+        body: &Body<D>,
+        grid: &Grid<D>,
+        initial_velocity: impl Fn(&SVector<f64, D>) -> SVector<f64, D>,
+    ) -> Self {
+        let (lo, hi, ppc) = (body.lower, body.upper, body.ppc);
         let spacing = grid.h / ppc as f64;
         let per_axis: [usize; D] =
             std::array::from_fn(|k| ((hi[k] - lo[k]) / grid.h).round() as usize * ppc);
@@ -74,7 +87,7 @@ impl<const D: usize> Particles<D> {
             spacing,
             per_axis,
         };
-        let (x0, volume): (Vec<SVector<f64, D>>, Vec<f64>) = match problem.placement() {
+        let (x0, volume): (Vec<SVector<f64, D>>, Vec<f64>) = match body.placement {
             Placement::SubCellCentres => {
                 let volume = spacing.powi(D as i32);
                 (0..count)
@@ -102,7 +115,7 @@ impl<const D: usize> Particles<D> {
                     .unzip()
             }
         };
-        let v = x0.iter().map(|x| problem.initial_velocity(x)).collect();
+        let v = x0.iter().map(initial_velocity).collect();
         Particles {
             x: x0.clone(),
             v,
@@ -113,7 +126,7 @@ impl<const D: usize> Particles<D> {
             ),
             j: filled(count, 1.0, "the particles' Jacobians"),
             stress,
-            mass: volume.iter().map(|v| problem.rho0() * v).collect(),
+            mass: volume.iter().map(|v| body.rho0 * v).collect(),
             volume0: volume.clone(),
             volume,
             lattice,

@@ -16,13 +16,14 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::benchmarks::AnyProblem;
-use crate::experiment::{Experiment, RunSpec};
+use crate::experiment::Experiment;
 use crate::output::{
     compute_run, describe_if_missing, read_message, remove_dead_temps, run_path, write_atomically,
     write_run, RunRecord, RunStatus,
 };
 use crate::parallel::with_threads;
 use crate::params::get_usize;
+use crate::run_spec::RunSpec;
 use crate::solver::{base_record, estimated_bytes, simulate_into};
 
 pub use memory::{parse_size, MemoryBudget, REFUSED};

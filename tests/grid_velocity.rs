@@ -6,8 +6,9 @@
 use std::path::Path;
 
 use mpmlab::benchmarks::{self, AnyProblem, Problem};
-use mpmlab::experiment::{self, RunSpec};
+use mpmlab::experiment;
 use mpmlab::output::{RunRecord, RunStatus};
+use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 /// Quarter of a period (t = T/4 = 5 ms), small deformation, 32 cells; the leapfrog (`mpm`,

@@ -3,9 +3,9 @@
 //! (`impm_fields_only`), against `mpm` and `impm` (docs/NOTES.md, experiments/gong_impm_isolation.yaml).
 
 use mpmlab::benchmarks::thesis_params;
-use mpmlab::experiment::RunSpec;
 use mpmlab::output::{RunRecord, RunStatus, ERROR_FIELDS};
 use mpmlab::params::Params;
+use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 fn run(benchmark: &str, method: &str, g: f64, cells: i64) -> RunRecord {

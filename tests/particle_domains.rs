@@ -1,9 +1,9 @@
 //! The particle-domain methods stepped end to end on Gong's manufactured solutions.
 
 use mpmlab::benchmarks::thesis_params;
-use mpmlab::experiment::RunSpec;
 use mpmlab::output::{RunRecord, RunStatus};
 use mpmlab::params::Params;
+use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 fn run(benchmark: &str, method: &str, g: f64, cells: i64, ppc: i64) -> RunRecord {

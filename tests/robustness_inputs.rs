@@ -410,7 +410,7 @@ fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
         "{failure}"
     );
     let dir = results_dir(out.path(), &experiment);
-    let summary = |run: &experiment::RunSpec| {
+    let summary = |run: &mpmlab::run_spec::RunSpec| {
         read_summary(&open_run_file(&run_path(&dir, &run.run_id)).unwrap()).unwrap()
     };
     assert_eq!(summary(large).status, RunStatus::Failed);

@@ -9,8 +9,10 @@ use std::path::Path;
 use hdf5::types::{TypeDescriptor, VarLenUnicode};
 use hdf5::{Attribute, Dataset, Group};
 
-use mpmlab::experiment::{self, RunSpec};
+use mpmlab::experiment;
+
 use mpmlab::output::{compute_run, run_path, write_hdf5};
+use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::{simulate, simulate_into};
 
 /// A value of a dataset or attribute, comparable bit for bit.

@@ -11,8 +11,10 @@
 
 use std::path::Path;
 
-use mpmlab::experiment::{self, RunSpec};
+use mpmlab::experiment;
+
 use mpmlab::output::{RunRecord, RunStatus};
+use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 /// Time steps from Courant number 0.24 down to 0.03 (c = 59.2 m/s, h = 0.1 m); 0.05 s is

@@ -15,7 +15,8 @@ use nalgebra::{SMatrix, SVector, Vector2};
 
 use super::limits::{check_lattice, courant_time_step};
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
-use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
+use crate::grid::Domain;
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_str, get_usize};
 use crate::particles::Placement;
@@ -286,9 +287,8 @@ mod tests {
         b.height / b.cells as f64
     }
     use crate::benchmarks::{catalog, default_params};
+    use crate::grid::Grid;
     use crate::params::ParamValue;
-    use crate::particles::Particles;
-    use crate::shape::Grid;
 
     fn block(overrides: &[(&str, ParamValue)]) -> AndersenBlock {
         let mut p = default_params(PARAMS);
@@ -357,7 +357,7 @@ mod tests {
         ] {
             let b = block(&[("placement", ParamValue::Str(placement.into()))]);
             let grid = Grid::new(&b.domain());
-            let particles = Particles::seed(&b, &grid);
+            let particles = b.seed_particles(&grid);
             assert_eq!(particles.len(), 100);
             let h = cell(&b);
             for (p, x) in particles.x0.iter().enumerate() {
@@ -381,7 +381,7 @@ mod tests {
     fn probes_take_the_middle_column() {
         let b = block(&[]);
         let grid = Grid::new(&b.domain());
-        let particles = Particles::seed(&b, &grid);
+        let particles = b.seed_particles(&grid);
         let low = 1.0 - 1.0 / 3f64.sqrt();
         let probes = b.probes();
         let top = particles.x0[probes[0].nearest(&particles.x0).unwrap()];

@@ -12,7 +12,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::limits::{check_lattice, courant_time_step};
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
-use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
+use crate::grid::Domain;
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_usize};
 

@@ -15,9 +15,10 @@ mod vibrating_bar;
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::grid::{Domain, Grid};
 use crate::material::Material;
 use crate::params::{ParamError, ParamValue, Params};
-use crate::particles::Placement;
+use crate::particles::{Body, Particles, Placement};
 
 pub use limits::{TimeStep, LIMIT_PARAMS, MAX_POINTS, MAX_STEPS, MAX_STEPS_KEY};
 pub use mms_gong::{gong_mms, thesis_params};
@@ -261,27 +262,6 @@ impl<const D: usize> Probe<D> {
     }
 }
 
-/// A uniform background grid over a box, `cells` cells per direction.
-#[derive(Clone, Copy, Debug)]
-pub struct Domain<const D: usize> {
-    pub lower: SVector<f64, D>,
-    pub upper: SVector<f64, D>,
-    pub cells: usize,
-}
-
-impl<const D: usize> Domain<D> {
-    /// The box [0, (cells + extra) h]^D with h = length / cells: a body of side `length` from
-    /// the origin, with `extra` empty cells beyond its upper faces for it to move into.
-    pub fn padded(length: f64, cells: usize, extra: usize) -> Self {
-        let total = cells + extra;
-        Domain {
-            lower: SVector::zeros(),
-            upper: SVector::repeat(total as f64 * (length / cells as f64)),
-            cells: total,
-        }
-    }
-}
-
 /// The `cfl` parameter of an explicit benchmark, refused above 1.
 fn courant_number(params: &Params) -> Result<f64, ParamError> {
     let cfl = crate::params::get_f64(params, "cfl")?;
@@ -326,6 +306,18 @@ pub trait Problem<const D: usize>: Send + Sync {
     /// Where the particles are seeded inside each cell.
     fn placement(&self) -> Placement {
         Placement::SubCellCentres
+    }
+    /// The particles of the body at rest in their initial state, on `grid`.
+    fn seed_particles(&self, grid: &Grid<D>) -> Particles<D> {
+        let (lower, upper) = self.body();
+        let body = Body {
+            lower,
+            upper,
+            ppc: self.ppc(),
+            placement: self.placement(),
+            rho0: self.rho0(),
+        };
+        Particles::seed(&body, grid, |x| self.initial_velocity(x))
     }
     fn probes(&self) -> Vec<Probe<D>> {
         Vec::new()

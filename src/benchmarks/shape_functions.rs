@@ -5,7 +5,8 @@
 use nalgebra::SVector;
 
 use super::limits::{check_count, largest, per_axis_total, power};
-use super::{BenchmarkInfo, BenchmarkKind, Domain, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
+use crate::grid::Domain;
 use crate::params::{get_f64, get_usize, ParamError, Params};
 use crate::shape::{LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
 

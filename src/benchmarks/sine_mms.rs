@@ -6,7 +6,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::TimeStep;
-use super::{Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec, Problem};
+use super::{ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec, Problem};
+use crate::grid::Domain;
 use crate::material::{Material, NeoHookean};
 
 /// Parameters every manufactured benchmark of this family takes with the same meaning.

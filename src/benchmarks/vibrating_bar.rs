@@ -9,8 +9,9 @@ use std::f64::consts::PI;
 use nalgebra::{SMatrix, SVector};
 
 use super::limits::{check_lattice, given_time_step};
-use super::{BenchmarkInfo, Domain, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use super::{ParamError, Params, Problem, TimeStep};
+use crate::grid::Domain;
 use crate::material::{LinearElasticRate, Material};
 use crate::params::{get_f64, get_str, get_usize};
 

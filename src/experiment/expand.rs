@@ -15,7 +15,7 @@ use super::run_id::{config_body, config_yaml, run_id};
 use super::space::{Block, ParamSpace, Written};
 use super::values::{method_names, METHOD_KEY};
 use super::yaml::child_field;
-use super::RunSpec;
+use crate::run_spec::RunSpec;
 
 /// The seeding parameter of benchmarks that offer a choice of particle placement.
 const PLACEMENT_KEY: &str = "placement";

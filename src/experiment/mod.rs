@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 use crate::benchmarks::{self, BenchmarkKind};
 use crate::output::Measures;
 use crate::params::Params;
+use crate::run_spec::RunSpec;
 
 pub use document::MAX_NAME_LEN;
 pub use error::ConfigError;
@@ -133,24 +134,6 @@ impl Experiment {
 pub struct OutputSpec {
     /// History sampling interval in steps (t = 0 and the final time are always sampled).
     pub every: usize,
-}
-
-/// Everything one run needs, fully resolved.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunSpec {
-    pub experiment: String,
-    /// Human-readable and stable: `<method>-<axis values>-<hash>`; the hash covers the
-    /// canonical resolved configuration, so the same YAML always gives the same ids.
-    pub run_id: String,
-    pub benchmark: String,
-    pub method: String,
-    /// Every benchmark parameter, defaults filled in (method excluded).
-    pub params: Params,
-    /// This run's value of each matrix axis (method included when it is an axis).
-    pub axes: Params,
-    pub output_every: usize,
-    /// The canonical resolved configuration as YAML, stored in each HDF5 file.
-    pub config_yaml: String,
 }
 
 /// One `expect` entry, checked by `mpmlab report --check`.

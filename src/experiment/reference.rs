@@ -10,7 +10,7 @@ use super::select::listed;
 use super::space::ParamSpace;
 use super::values::normalize;
 use super::yaml::{child_field, Entry};
-use super::RunSpec;
+use crate::run_spec::RunSpec;
 
 const FIELD: &str = "reference";
 

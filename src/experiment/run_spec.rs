@@ -7,7 +7,7 @@ use serde_json::{json, Map, Value};
 use crate::params::{ParamValue, Params};
 
 use super::values::METHOD_KEY;
-use super::RunSpec;
+use crate::run_spec::RunSpec;
 
 impl RunSpec {
     pub fn to_json(&self) -> Value {

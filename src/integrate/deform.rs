@@ -2,7 +2,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::Divergence;
+use crate::divergence::Divergence;
 use crate::material::{det, Material};
 use crate::parallel;
 use crate::particles::{ParticleChunk, Particles};

@@ -7,11 +7,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::deform::deform_particle;
-use super::Divergence;
+use crate::divergence::Divergence;
+use crate::grid::GridState;
 use crate::material::Material;
 use crate::parallel;
 use crate::particles::{ParticleChunk, Particles};
-use crate::reconstruct::GridState;
 use crate::shape::Stencils;
 
 /// Step 3 of Gong sec 4.4, one pass per particle with N and grad N taken at x_p^s:

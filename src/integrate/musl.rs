@@ -7,9 +7,9 @@
 
 use nalgebra::SVector;
 
-use super::Divergence;
+use crate::divergence::Divergence;
+use crate::grid::GridState;
 use crate::particles::Particles;
-use crate::reconstruct::GridState;
 use crate::shape::Stencils;
 
 /// Eqs 34-35: v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the nodal velocity

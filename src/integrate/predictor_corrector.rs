@@ -17,9 +17,12 @@
 use nalgebra::SVector;
 
 use super::musl::move_particles;
-use super::{solve_grid, Divergence, FixedDof};
+use super::solve_grid;
+use crate::divergence::Divergence;
+use crate::grid::FixedDof;
+use crate::grid::GridState;
 use crate::particles::Particles;
-use crate::reconstruct::{map_velocity, GridState};
+use crate::reconstruct::map_velocity;
 use crate::shape::Stencils;
 
 /// The particle accelerations the predictor needs, and the scratch arrays of one step; sized
@@ -103,8 +106,9 @@ impl<const D: usize> PredictorCorrector<D> {
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem};
+    use crate::grid::Grid;
     use crate::reconstruct::nodal_forces;
-    use crate::shape::{Grid, LinearHat, Shape};
+    use crate::shape::{LinearHat, Shape};
     use nalgebra::SMatrix;
 
     /// One particle on a grid of one cell [0, 1] at x, with its stencil.
@@ -112,7 +116,7 @@ mod tests {
         let problem = gong_mms::<1>(&thesis_params(0.0, 1, 1)).unwrap();
         let grid = Grid::<1>::new(&problem.domain());
         assert_eq!((grid.lower[0], grid.h), (0.0, 1.0));
-        let mut particles = Particles::seed(&problem, &grid);
+        let mut particles = problem.seed_particles(&grid);
         assert_eq!(particles.len(), 1);
         particles.x[0] = SVector::repeat(x);
         let mut stencils = Stencils::new(Shape::<1>::nodes_per_point(&LinearHat), 1);

@@ -77,6 +77,16 @@ pub fn map_fields(kind: BenchmarkKind) -> &'static [&'static str] {
     }
 }
 
+/// The unit of a particle or grid field's values.
+pub(super) fn field_unit(field: &str) -> &'static str {
+    match field {
+        "displacement" => "m",
+        "velocity" | GRID_VELOCITY => "m/s",
+        "stress" => "Pa",
+        _ => "kg/m^D",
+    }
+}
+
 /// The error fields a kind of run reports, each in each of the norms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Measures {
@@ -284,6 +294,7 @@ pub struct VelocityHistory {
 
 mod atomic;
 mod elements;
+mod h5;
 mod probes;
 mod reader;
 mod reconstruction;

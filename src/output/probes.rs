@@ -4,8 +4,7 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{open_attr, open_dataset, read_i64, read_str};
-use super::writer::{attr_f64, attr_i64, attr_str};
+use super::h5::{attr_f64, attr_i64, attr_str, open_attr, open_dataset, read_i64, read_str};
 
 pub(super) const GROUP: &str = "probes";
 pub(super) const TIME: &str = "time";

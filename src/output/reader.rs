@@ -3,10 +3,11 @@ use std::fs;
 use std::io::{self, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
-use hdf5::types::{TypeDescriptor, VarLenUnicode};
-use hdf5::{Attribute, Dataset, Group, Location};
+use hdf5::types::TypeDescriptor;
+use hdf5::Group;
 use ndarray::s;
 
+use super::h5::{group, open_attr, open_dataset, read_f64, read_i64, read_str, shaped};
 use super::{
     elements, probes, reconstruction, shape_functions, ParticleState, ProbeRecord, RunStatus,
     RunSummary, VelocityHistory, ERROR_FIELDS_WITH_GRID, GRID_VELOCITY, NORMS, SCHEMA_VERSION,
@@ -325,98 +326,4 @@ fn read_params(group: &Group) -> hdf5::Result<Params> {
         params.insert(name, ParamValue::List(values));
     }
     Ok(params)
-}
-
-/// Where `name` lies below `group`, as h5dump writes it: `/history/x`.
-fn path_in(group: &Group, name: &str) -> String {
-    format!("{}/{name}", group.name().trim_end_matches('/'))
-}
-
-/// The group `name` of `parent` (a path below it).
-fn group(parent: &Group, name: &str) -> hdf5::Result<Group> {
-    if !parent.link_exists(name) {
-        return Err(format!("lacks {}", path_in(parent, name)).into());
-    }
-    parent
-        .group(name)
-        .map_err(|_| format!("{} is not a group", path_in(parent, name)).into())
-}
-
-/// The dataset `name` of `group` (a path below it, such as `history/x`).
-pub(super) fn open_dataset(group: &Group, name: &str) -> hdf5::Result<Dataset> {
-    if !group.link_exists(name) {
-        return Err(format!("lacks {}", path_in(group, name)).into());
-    }
-    group
-        .dataset(name)
-        .map_err(|_| format!("{} is not a dataset", path_in(group, name)).into())
-}
-
-/// A dataset of the shape `expected`, where `None` takes any length on its axis: what a
-/// slice of it needs, and what keeps the arrays of one run the same length.
-fn shaped(group: &Group, name: &str, expected: &[Option<usize>]) -> hdf5::Result<Dataset> {
-    let ds = open_dataset(group, name)?;
-    let shape = ds.shape();
-    let path = path_in(group, name);
-    if shape.len() != expected.len() {
-        return Err(format!(
-            "dataset {path} has {} dimensions, {} expected",
-            shape.len(),
-            expected.len()
-        )
-        .into());
-    }
-    if shape
-        .iter()
-        .zip(expected)
-        .any(|(&n, e)| e.is_some_and(|e| e != n))
-    {
-        let text = |axes: Vec<String>| format!("({})", axes.join(", "));
-        let want = expected
-            .iter()
-            .map(|e| e.map_or("any".into(), |n| n.to_string()));
-        return Err(format!(
-            "dataset {path} has shape {}, {} expected",
-            text(shape.iter().map(usize::to_string).collect()),
-            text(want.collect())
-        )
-        .into());
-    }
-    Ok(ds)
-}
-
-/// The attribute `name` of `loc`, said in errors as `the attribute 'name'` (of the root) or
-/// `the attribute 'name' of /errors/norms`.
-fn attr_words(loc: &Location, name: &str) -> String {
-    match loc.name().as_str() {
-        "/" => format!("the attribute '{name}'"),
-        place => format!("the attribute '{name}' of {place}"),
-    }
-}
-
-pub(super) fn open_attr(loc: &Location, name: &str) -> hdf5::Result<Attribute> {
-    loc.attr(name)
-        .map_err(|_| format!("lacks {}", attr_words(loc, name)).into())
-}
-
-/// A scalar attribute read as `T`, which names `kind` in its error.
-fn scalar<T: hdf5::H5Type>(loc: &Location, name: &str, kind: &str) -> hdf5::Result<T> {
-    let attr = open_attr(loc, name)?;
-    if !attr.is_scalar() {
-        return Err(format!("{} is not a single value", attr_words(loc, name)).into());
-    }
-    attr.read_scalar::<T>()
-        .map_err(|_| format!("{} is not {kind}", attr_words(loc, name)).into())
-}
-
-pub(super) fn read_str(loc: &Location, name: &str) -> hdf5::Result<String> {
-    Ok(scalar::<VarLenUnicode>(loc, name, "a string")?.to_string())
-}
-
-pub(super) fn read_f64(loc: &Location, name: &str) -> hdf5::Result<f64> {
-    scalar(loc, name, "a number")
-}
-
-pub(super) fn read_i64(loc: &Location, name: &str) -> hdf5::Result<i64> {
-    scalar(loc, name, "an integer")
 }

@@ -5,8 +5,9 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{open_dataset, read_f64, read_i64, read_str};
-use super::writer::{attr_f64, attr_i64, attr_str, dataset};
+use super::h5::{
+    attr_f64, attr_i64, attr_str, dataset, open_dataset, read_f64, read_i64, read_str,
+};
 
 const GROUP: &str = "reconstruction";
 const BASIS: &str = "basis";

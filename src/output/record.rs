@@ -1,8 +1,8 @@
 use super::{
     ElementRecord, HistoryStream, ProbeRecord, ReconstructionRecord, RunStatus, ShapeFunctionRecord,
 };
-use crate::experiment::RunSpec;
 use crate::methods::Method;
+use crate::run_spec::RunSpec;
 
 /// Everything written to one run file, as flat row-major arrays so that the layout does
 /// not depend on the dimension at compile time.

@@ -6,8 +6,9 @@
 
 use hdf5::{File, Group};
 
-use super::reader::{open_dataset, read_f64, read_i64, read_str};
-use super::writer::{attr_f64, attr_i64, attr_str, dataset};
+use super::h5::{
+    attr_f64, attr_i64, attr_str, dataset, open_dataset, read_f64, read_i64, read_str,
+};
 use super::SHAPE_FIELDS;
 
 const GROUP: &str = "shape_functions";

@@ -6,8 +6,8 @@
 use hdf5::{Dataset, Extent, Group, H5Type, Hyperslab, SimpleExtents, SliceOrIndex};
 use ndarray::{ArrayView, IxDyn};
 
+use super::h5::{attr_str, dataset};
 use super::probes::{self, WiggleTally};
-use super::writer::{attr_str, dataset};
 use super::{Errors, GridHistory, History, ProbeRecord, Wiggles, ERROR_FIELDS, GRID_VELOCITY};
 
 /// About 1 MiB of float64 per chunk: large enough that a write per chunk costs little, small
@@ -202,13 +202,7 @@ impl HistoryStream {
         let grid = file.create_group("grid")?;
         let errors = file.create_group("errors")?;
         let field = |name: &'static str, points: usize| {
-            Appender::new(
-                &errors,
-                name,
-                &[points],
-                super::writer::field_unit(name),
-                nt,
-            )
+            Appender::new(&errors, name, &[points], super::field_unit(name), nt)
         };
         let probe_group = if probe_records.is_empty() {
             None

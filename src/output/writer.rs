@@ -1,13 +1,12 @@
 use std::path::Path;
 
-use hdf5::types::VarLenUnicode;
-use hdf5::{Group, H5Type, Location};
-use ndarray::{ArrayView, IxDyn};
+use hdf5::Group;
 
+use super::h5::{attr_f64, attr_i64, attr_str, dataset, string_dataset};
 use super::stream::{HistoryStream, StreamShape};
 use super::{
-    elements, probes, reconstruction, shape_functions, RunRecord, CONFIG_YAML, ERROR_FIELDS,
-    GRID_VELOCITY, SCHEMA_VERSION,
+    elements, field_unit, probes, reconstruction, shape_functions, RunRecord, CONFIG_YAML,
+    ERROR_FIELDS, GRID_VELOCITY, SCHEMA_VERSION,
 };
 use crate::params::ParamValue;
 
@@ -165,32 +164,6 @@ fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
     Ok(())
 }
 
-pub(super) fn field_unit(field: &str) -> &'static str {
-    match field {
-        "displacement" => "m",
-        "velocity" | GRID_VELOCITY => "m/s",
-        "stress" => "Pa",
-        _ => "kg/m^D",
-    }
-}
-
-fn shape_error(e: ndarray::ShapeError) -> hdf5::Error {
-    hdf5::Error::from(format!("array shape: {e}"))
-}
-
-/// A dataset of `shape` (row-major `data`) with its `units` attribute.
-pub(super) fn dataset<T: H5Type>(
-    group: &Group,
-    name: &str,
-    data: &[T],
-    shape: &[usize],
-    unit: &str,
-) -> hdf5::Result<()> {
-    let view = ArrayView::from_shape(IxDyn(shape), data).map_err(shape_error)?;
-    let ds = group.new_dataset_builder().with_data(view).create(name)?;
-    attr_str(&ds, "units", unit)
-}
-
 /// A scalar parameter as an attribute of `group`, a list as a dataset in it (of any length,
 /// which an attribute is not).
 fn write_param(group: &Group, key: &str, value: &ParamValue) -> hdf5::Result<()> {
@@ -204,39 +177,4 @@ fn write_param(group: &Group, key: &str, value: &ParamValue) -> hdf5::Result<()>
             .create(key)?
             .write_raw(values),
     }
-}
-
-fn string_dataset(group: &Group, name: &str, value: &str) -> hdf5::Result<()> {
-    group
-        .new_dataset::<VarLenUnicode>()
-        .shape(())
-        .create(name)?
-        .write_scalar(&to_unicode(name, value)?)
-}
-
-fn to_unicode(name: &str, value: &str) -> hdf5::Result<VarLenUnicode> {
-    value
-        .parse()
-        .map_err(|e| hdf5::Error::from(format!("{name}: {e}")))
-}
-
-pub(super) fn attr_str(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
-    loc.new_attr::<VarLenUnicode>()
-        .shape(())
-        .create(name)?
-        .write_scalar(&to_unicode(name, value)?)
-}
-
-pub(super) fn attr_f64(loc: &Location, name: &str, value: f64) -> hdf5::Result<()> {
-    loc.new_attr::<f64>()
-        .shape(())
-        .create(name)?
-        .write_scalar(&value)
-}
-
-pub(super) fn attr_i64(loc: &Location, name: &str, value: i64) -> hdf5::Result<()> {
-    loc.new_attr::<i64>()
-        .shape(())
-        .create(name)?
-        .write_scalar(&value)
 }

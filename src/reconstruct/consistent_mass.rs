@@ -9,8 +9,9 @@ use nalgebra::SVector;
 
 use super::mass_matrix::{MassMatrix, MassSolver};
 use super::shepard::{momentum_sums, particle_sums};
-use super::GridState;
-use crate::integrate::{Divergence, FixedDof};
+use crate::divergence::Divergence;
+use crate::grid::FixedDof;
+use crate::grid::GridState;
 use crate::particles::Particles;
 use crate::shape::Stencils;
 
@@ -74,10 +75,11 @@ impl<const D: usize> ConsistentMassTransfer<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::Domain;
+    use crate::grid::{Dofs, Grid};
     use crate::particles::SeedLattice;
     use crate::reconstruct::remap_velocity;
-    use crate::shape::{Dofs, Grid, QuadraticBSpline, Shape};
+    use crate::shape::{QuadraticBSpline, Shape};
     use nalgebra::SMatrix;
 
     /// The open quadratic B-spline on [0, cells] (h = 1) with three particles of unit mass per
@@ -321,7 +323,7 @@ mod tests {
         let prob = crate::benchmarks::gong_mms::<2>(&crate::benchmarks::thesis_params(1e-4, 32, 2))
             .unwrap();
         let grid = Grid::with_dofs(&prob.domain(), dofs);
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut rng = crate::rng::Lcg::new(5);
         let field = |x: &SVector<f64, 2>| {
             SVector::<f64, 2>::from([1.0 + 2.0 * x[0] - x[1], 3.0 - x[0] + 4.0 * x[1]])

@@ -3,7 +3,8 @@
 
 use nalgebra::SVector;
 
-use crate::shape::{lattice_strides, Dofs, Grid};
+use crate::gauss::gauss_legendre;
+use crate::grid::{lattice_strides, Dofs, Grid};
 
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
@@ -141,22 +142,10 @@ impl<const D: usize> Lattice<D> {
     }
 }
 
-/// Gauss-Legendre abscissae and weights on [-1, 1].
-pub(crate) fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
-    const A2: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
-    const A3: f64 = 0.774_596_669_241_483_4; // sqrt(3/5)
-    match n {
-        1 => (&[0.0], &[2.0]),
-        2 => (&[-A2, A2], &[1.0, 1.0]),
-        3 => (&[-A3, 0.0, A3], &[5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]),
-        _ => panic!("Gauss-Legendre rules with 1 to 3 points are tabulated, not {n}"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::Domain;
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
         Grid::new(&Domain {

@@ -10,8 +10,9 @@ use super::conjugate_gradients::{
 };
 use super::diagonals::SymmetricDiagonals;
 use super::line_sums::LineSums;
-use super::GridState;
-use crate::integrate::{Divergence, FixedDof};
+use crate::divergence::Divergence;
+use crate::grid::FixedDof;
+use crate::grid::GridState;
 
 /// Which mass matrix the nodal velocity and acceleration are solved with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -11,9 +11,11 @@ use nalgebra::{SMatrix, SVector};
 use num_traits::Zero;
 
 use super::shepard::{map_velocity, remap_velocity};
-use super::{FitStats, GridState, Lattice, Recipe, Reconstructor, SingularMoments};
+use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments};
+use crate::grid::Grid;
+use crate::grid::GridState;
 use crate::particles::Particles;
-use crate::shape::{Grid, LinearHat, Shape, Stencils};
+use crate::shape::{LinearHat, Shape, Stencils};
 
 /// The parts of a quadrature transfer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -298,7 +300,7 @@ mod tests {
     fn check_balance<const D: usize>() {
         let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut rng = crate::rng::Lcg::new(99);
         for p in 0..particles.len() {
             particles.stress[p] = SMatrix::from_fn(|_, _| 1e3 * (rng.unit() - 0.5));
@@ -352,7 +354,7 @@ mod tests {
     fn check_shepard_velocity<const D: usize>() {
         let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut rng = crate::rng::Lcg::new(31);
         for p in 0..particles.len() {
             particles.x[p] += SVector::<f64, D>::from_fn(|_, _| 0.02 * (rng.unit() - 0.5));
@@ -432,7 +434,7 @@ mod tests {
         for ppc in [2, 4] {
             let prob = gong_mms::<1>(&thesis_params(1e-4, cells as i64, ppc as i64)).unwrap();
             let grid = Grid::new(&prob.domain());
-            let particles = Particles::seed(&prob, &grid);
+            let particles = prob.seed_particles(&grid);
             let h = grid.h;
             let mode = |x: f64| (std::f64::consts::PI * x).sin();
             let x: Vec<f64> = particles.x.iter().map(|x| x[0]).collect();
@@ -565,7 +567,7 @@ mod tests {
     fn the_product_fit_reproduces_a_linear_rho_b() {
         let prob = gong_mms::<1>(&thesis_params(0.1, 8, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut body = Vec::new();
         for p in 0..particles.len() {
             let x = particles.x[p][0];

@@ -1,6 +1,6 @@
 use nalgebra::SVector;
 
-use super::GridState;
+use crate::grid::GridState;
 use crate::parallel;
 use crate::particles::Particles;
 use crate::shape::Stencils;
@@ -170,7 +170,8 @@ fn momentum_to_velocity<const D: usize>(
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem, SineMms};
-    use crate::shape::{Grid, LinearHat, Shape};
+    use crate::grid::Grid;
+    use crate::shape::{LinearHat, Shape};
     use nalgebra::SMatrix;
 
     fn problem<const D: usize>() -> SineMms<D> {
@@ -182,7 +183,7 @@ mod tests {
     fn check_conservation<const D: usize>() {
         let prob = problem::<D>();
         let grid = Grid::new(&prob.domain());
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut rng = crate::rng::Lcg::new(12345);
         let mut rand = || rng.unit() - 0.5;
         for p in 0..particles.len() {

@@ -10,13 +10,16 @@ use std::fmt;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::gauss::gauss_legendre_rule;
 use super::mass_matrix::{MassMatrix, MassSolver};
 use super::taylor::{Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
-use super::{FitStats, GridState};
-use crate::integrate::{Divergence, FixedDof};
+use super::FitStats;
+use crate::divergence::Divergence;
+use crate::gauss::gauss_legendre_rule;
+use crate::grid::FixedDof;
+use crate::grid::GridState;
+use crate::grid::{lattice_coords, Grid};
 use crate::particles::Particles;
-use crate::shape::{lattice_coords, Grid, Shape, Stencils};
+use crate::shape::{Shape, Stencils};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TaylorRecipe {
@@ -370,7 +373,8 @@ impl fmt::Display for TaylorRecipe {
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem};
-    use crate::shape::{Dofs, LinearHat, QuadraticBSpline};
+    use crate::grid::Dofs;
+    use crate::shape::{LinearHat, QuadraticBSpline};
 
     fn recipe(mass: MassMatrix) -> TaylorRecipe {
         TaylorRecipe {
@@ -389,7 +393,7 @@ mod tests {
     ) -> (Grid<D>, Particles<D>, Stencils<D>) {
         let prob = gong_mms::<D>(&thesis_params(0.1, 6, 3)).unwrap();
         let grid = Grid::new(&prob.domain());
-        let mut particles = Particles::seed(&prob, &grid);
+        let mut particles = prob.seed_particles(&grid);
         let mut rng = crate::rng::Lcg::new(5);
         let spacing = particles.lattice.spacing;
         for p in 0..particles.len() {
@@ -406,8 +410,8 @@ mod tests {
     }
 
     /// The domain a grid was built on.
-    fn domain<const D: usize>(grid: &Grid<D>) -> crate::benchmarks::Domain<D> {
-        crate::benchmarks::Domain {
+    fn domain<const D: usize>(grid: &Grid<D>) -> crate::grid::Domain<D> {
+        crate::grid::Domain {
             lower: grid.lower,
             upper: grid.lower.add_scalar(grid.h * grid.cells as f64),
             cells: grid.cells,

@@ -3,9 +3,9 @@
 use nalgebra::SVector;
 
 use super::*;
-use crate::benchmarks::Domain;
+use crate::grid::Domain;
+use crate::grid::Grid;
 use crate::rng::Lcg;
-use crate::shape::Grid;
 
 fn grid<const D: usize>(cells: usize) -> Grid<D> {
     Grid::new(&Domain {

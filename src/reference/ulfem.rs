@@ -8,7 +8,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::benchmarks::Problem;
-use crate::integrate::Divergence;
+use crate::divergence::Divergence;
 use crate::material::Material;
 use crate::particles::{Particles, SeedLattice};
 

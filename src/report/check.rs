@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use super::claims;
+use super::claims::{self, Outcome, Verdict};
 use super::format::{exact, general};
 use super::group::{label, ordered_runs, selects};
 use super::stability::{group_name, limits};
@@ -46,7 +46,7 @@ pub fn check(experiment: &Experiment, rates: &[RateRow], runs: &[RunSummary]) ->
                 message,
             })
         })
-        .chain(claims::failures(&claims::evaluate(experiment, rates, runs)))
+        .chain(claim_failures(&claims::evaluate(experiment, rates, runs)))
         .collect()
 }
 
@@ -207,6 +207,29 @@ fn beside(value: f64, bound: f64) -> String {
                 .is_ok_and(|shown| shown.partial_cmp(&bound) == value.partial_cmp(&bound))
         })
         .unwrap_or_else(|| exact(value))
+}
+
+/// A claim `--check` cannot let pass: unexplained, stale or unmeasured.
+fn claim_failures(outcomes: &[Outcome]) -> Vec<CheckFailure> {
+    outcomes
+        .iter()
+        .filter(|o| !matches!(o.verdict, Verdict::Reproduced | Verdict::Differs))
+        .map(|o| CheckFailure {
+            line: o.claim.line,
+            message: format!(
+                "paper claim {} ({}): paper {}, ours {}: {}",
+                o.claim.item,
+                o.claim.claim,
+                o.paper_text(),
+                if o.ours.is_empty() {
+                    "none".into()
+                } else {
+                    o.ours_text()
+                },
+                o.verdict.as_str()
+            ),
+        })
+        .collect()
 }
 
 #[cfg(test)]

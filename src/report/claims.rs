@@ -1,7 +1,6 @@
 //! The papers' claims against our runs: each `paper_claims` entry's number beside what the
 //! selected runs measure, and a verdict.
 
-use super::check::CheckFailure;
 use super::figures::Figure;
 use super::format::general;
 use super::group::{label, ordered_runs, selects};
@@ -171,27 +170,4 @@ pub fn claim_figures<'a>(
     figures.iter().filter(move |f| {
         name.is_some() && f.drawn_by.as_deref() == name && f.variant.iter().all(allows)
     })
-}
-
-/// A claim `--check` cannot let pass: unexplained, stale or unmeasured.
-pub fn failures(outcomes: &[Outcome]) -> Vec<CheckFailure> {
-    outcomes
-        .iter()
-        .filter(|o| !matches!(o.verdict, Verdict::Reproduced | Verdict::Differs))
-        .map(|o| CheckFailure {
-            line: o.claim.line,
-            message: format!(
-                "paper claim {} ({}): paper {}, ours {}: {}",
-                o.claim.item,
-                o.claim.claim,
-                o.paper_text(),
-                if o.ours.is_empty() {
-                    "none".into()
-                } else {
-                    o.ours_text()
-                },
-                o.verdict.as_str()
-            ),
-        })
-        .collect()
 }

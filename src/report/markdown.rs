@@ -8,7 +8,7 @@ use super::claims::{claim_figures, Outcome, COLUMNS};
 use super::figures::{FieldMap, Figure};
 use super::format::{general, rate};
 use super::group::{self, label, ordered_runs, RELATIVE_ROUND_OFF};
-use super::pointwise::Table;
+use super::table::Table;
 use super::RateRow;
 use crate::benchmarks::BenchmarkKind;
 use crate::experiment::Experiment;

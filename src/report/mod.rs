@@ -19,6 +19,7 @@ mod pointwise;
 mod probe_table;
 pub mod stability;
 mod style;
+mod table;
 mod tables;
 mod units;
 

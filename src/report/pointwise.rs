@@ -5,22 +5,12 @@
 //! run files unchanged.
 
 use super::format::general;
-use super::group::{
-    axis_values, group_runs, label, ordered_runs, scoped_label, selects, title_suffix,
-};
+use super::group::{group_runs, label, ordered_runs, scoped_label, selects, title_suffix};
 use super::probe_table;
 use super::stability;
+use super::table::{per_run_rows, Table};
 use crate::experiment::{Experiment, TableKind, TableSpec};
 use crate::output::{ElementRecord, ReconstructionRecord, RunStatus, RunSummary};
-
-/// A table with a heading and a note on how to read it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Table {
-    pub title: String,
-    pub note: String,
-    pub header: Vec<String>,
-    pub rows: Vec<Vec<String>>,
-}
 
 /// Every table the experiment's `tables` entries ask for, in their order; an error names a
 /// probe no selected run records.
@@ -186,29 +176,6 @@ fn element_fits<'a>(
         header,
         rows,
     })
-}
-
-/// The header and rows of a table with one row per run, in the order of the run tables: the
-/// run's axis values and status, then `columns`, filled by `cells`.
-pub(super) fn per_run_rows(
-    experiment: &Experiment,
-    runs: &[&RunSummary],
-    columns: impl IntoIterator<Item = String>,
-    cells: impl Fn(&RunSummary) -> Vec<String>,
-) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut header = experiment.axes.clone();
-    header.push("status".to_string());
-    header.extend(columns);
-    let rows = runs
-        .iter()
-        .map(|run| {
-            let mut row: Vec<String> = axis_values(experiment, run).collect();
-            row.push(run.status.as_str().to_string());
-            row.extend(cells(run));
-            row
-        })
-        .collect();
-    (header, rows)
 }
 
 /// One row per run: its final error in the spec's field and norm (empty for a run that stopped

@@ -4,7 +4,7 @@
 
 use super::format::general;
 use super::group::{label, ordered_runs, recorded_probes, title_suffix};
-use super::pointwise::{per_run_rows, Table};
+use super::table::{per_run_rows, Table};
 use crate::experiment::{Experiment, ProbeWindow, TableSpec};
 use crate::output::{ProbeRecord, RunSummary};
 

@@ -12,7 +12,7 @@
 
 use super::format::general;
 use super::group::{group_runs, label, label_or_all, scoped_label, title_suffix};
-use super::pointwise::Table;
+use super::table::Table;
 use crate::experiment::{StabilityAxes, TableSpec};
 use crate::linear_stability::{
     printed_bound, projected_bound, projected_bound_fixed_ends, squared_bound,

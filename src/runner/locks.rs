@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use super::needs_run;
-use crate::experiment::RunSpec;
 use crate::output::{run_path, this_host, TempHost, TempWriter};
+use crate::run_spec::RunSpec;
 
 fn lock_path(dir: &Path, run_id: &str) -> PathBuf {
     dir.join("runs").join(format!(".{run_id}.lock"))

@@ -4,7 +4,7 @@
 
 use nalgebra::SVector;
 
-use super::Grid;
+use crate::grid::Grid;
 
 /// Nodes per axis in a block stencil: a particle domain may span up to three cells, and the
 /// dual-domain gradient reaches one node beyond the point's cell on each side.

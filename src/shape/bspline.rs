@@ -4,7 +4,8 @@
 use nalgebra::SVector;
 
 use super::block::next_block_entry;
-use super::{Dofs, Grid, Shape};
+use super::Shape;
+use crate::grid::{Dofs, Grid};
 
 /// B-splines per axis that are nonzero at a point.
 const PER_AXIS: usize = 3;
@@ -101,9 +102,10 @@ mod tests {
     use nalgebra::SMatrix;
 
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::lattice_coords;
+    use crate::grid::Domain;
     use crate::shape::stencils::assert_gradient_matches_differences;
-    use crate::shape::{lattice_coords, Stencils};
+    use crate::shape::Stencils;
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
         Grid::with_dofs(

@@ -8,7 +8,8 @@
 use nalgebra::SVector;
 
 use super::block::{block_around_cell, for_each_block_node, NODES_PER_AXIS};
-use super::{lattice_coords, Dofs, Grid, LinearHat, Shape};
+use super::{LinearHat, Shape};
+use crate::grid::{lattice_coords, Dofs, Grid};
 
 /// Offsets i - j per axis of the nodes i whose hat overlaps that of node j: -1, 0, 1.
 const NEIGHBOURS_PER_AXIS: usize = 3;
@@ -312,9 +313,10 @@ mod tests {
     use nalgebra::SMatrix;
 
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::lattice_coords;
+    use crate::grid::Domain;
     use crate::rng::Lcg;
-    use crate::shape::{lattice_coords, Stencils};
+    use crate::shape::Stencils;
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
         Grid::new(&Domain {

@@ -1,6 +1,8 @@
 use nalgebra::SVector;
 
-use super::{Dofs, Grid, Shape};
+use super::Shape;
+
+use crate::grid::{Dofs, Grid};
 
 /// The piecewise-linear hat of Gong eq 4.8, a tensor product in 2D: 2^D nodes per point, the
 /// corners of the point's cell, entry `corner` with bit k set for the upper node along axis k.

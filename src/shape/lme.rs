@@ -14,7 +14,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use nalgebra::{SMatrix, SVector};
 
 use super::block::{block_from, next_block_entry};
-use super::{Dofs, Grid, Shape, Stencils};
+use super::{Shape, Stencils};
+use crate::grid::{Dofs, Grid};
 
 /// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
 /// exp(-beta |x - x_a|^2) is below it are left out.

@@ -4,17 +4,17 @@ mod block;
 mod bspline;
 mod domain;
 mod dual_domain;
-mod grid;
 mod linear;
 mod lme;
 mod stencils;
 
 use nalgebra::SVector;
 
+use crate::grid::Grid;
+
 pub use bspline::QuadraticBSpline;
-pub use domain::{DomainFault, DomainShape, ParticleDomains};
+pub use domain::{DomainShape, ParticleDomains};
 pub use dual_domain::{DualDomain, DualIntegrals};
-pub use grid::{lattice_coords, lattice_strides, Dofs, Grid};
 pub use linear::LinearHat;
 pub use lme::{
     LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, MAX_STENCIL_NODES,

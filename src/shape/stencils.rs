@@ -3,7 +3,9 @@ use nalgebra::SVector;
 use crate::fallible::filled;
 use crate::parallel;
 
-use super::{Grid, Shape};
+use super::Shape;
+
+use crate::grid::Grid;
 
 /// Shape-function values of every particle, `per_point` entries each, stored flat so
 /// that the transfer loops walk memory in order and nothing is allocated per step.
@@ -279,7 +281,7 @@ pub(crate) fn assert_gradient_matches_differences<S: Shape<D>, const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::Domain;
     use crate::shape::LinearHat;
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {

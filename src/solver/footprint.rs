@@ -8,13 +8,12 @@
 //! does not grow with the number of samples.
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
-use crate::experiment::RunSpec;
+use crate::grid::{Dofs, Grid};
 use crate::methods::{self, Method, ShapeKind, TransferKind};
 use crate::params::get_usize;
 use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe};
-use crate::shape::{
-    Dofs, DualDomain, Grid, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape,
-};
+use crate::run_spec::RunSpec;
+use crate::shape::{DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape};
 
 /// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
 /// growing dataset).

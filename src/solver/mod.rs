@@ -14,17 +14,20 @@ use std::time::Instant;
 use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
-use crate::experiment::RunSpec;
+use crate::divergence::Divergence;
+use crate::grid::FixedDof;
+use crate::grid::GridState;
+use crate::grid::{Dofs, Grid};
 use crate::integrate::predictor_corrector::PredictorCorrector;
-use crate::integrate::{self, leapfrog, musl, Divergence, FixedDof};
+use crate::integrate::{self, leapfrog, musl};
 use crate::methods::{self, IntegratorKind, Method, ShapeKind};
 use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
 use crate::parallel;
 use crate::particles::Particles;
-use crate::reconstruct::{nodal_forces, FitStats, GridState};
+use crate::reconstruct::{nodal_forces, FitStats};
+use crate::run_spec::RunSpec;
 use crate::shape::{
-    Dofs, DualDomain, Grid, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape,
-    Stencils,
+    DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape, Stencils,
 };
 
 pub use footprint::estimated_bytes;
@@ -163,7 +166,7 @@ impl<'a, const D: usize> Run<'a, D> {
             | ShapeKind::LocalMaxEnt(_) => Dofs::Nodes,
         };
         let grid = Grid::with_dofs(&problem.domain(), dofs);
-        let particles = Particles::seed(problem.as_ref(), &grid);
+        let particles = problem.seed_particles(&grid);
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
         let mut recorder = Recorder::new();

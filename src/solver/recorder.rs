@@ -2,12 +2,12 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{ProbeQuantity, Problem};
 use crate::experiment::sample_count;
+use crate::grid::Grid;
 use crate::output::{
     Conservation, Errors, GridHistory, History, HistoryStream, ProbeRecord, StreamShape,
     REFERENCE_KINDS,
 };
 use crate::particles::Particles;
-use crate::shape::Grid;
 
 /// Appends sampled particle states and grid velocities, their errors against the exact
 /// solution and the mass totals, and every step the values at the problem's probes. With a
@@ -338,7 +338,7 @@ fn nan_max(current: f64, value: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, SineMms};
-    use crate::shape::Dofs;
+    use crate::grid::Dofs;
 
     /// Sampled at t = 3.7 ms, when the material has moved by up to 3.3 % of the box, with a
     /// grid velocity that belongs to 4.2 ms.
@@ -372,7 +372,7 @@ mod tests {
     /// A sample at `T` with the grid velocity `v` belonging to `T_GRID`.
     fn sample(recorder: &mut Recorder<2>, problem: &SineMms<2>, v: &[SVector<f64, 2>]) {
         let grid = Grid::new(&problem.domain());
-        let particles = Particles::seed(problem, &grid);
+        let particles = problem.seed_particles(&grid);
         let velocity = particles.v.clone();
         let sample = GridSample {
             mass: 0.0,
@@ -448,7 +448,7 @@ mod tests {
         let grid = Grid::new(&problem.domain());
         let mut recorder = Recorder::<1>::new();
         recorder.attach_grid(&grid);
-        let particles = Particles::seed(&problem, &grid);
+        let particles = problem.seed_particles(&grid);
         let nodal = vec![SVector::zeros(); grid.num_nodes()];
         let sample = GridSample {
             mass: 0.0,

@@ -6,9 +6,9 @@ use nalgebra::SVector;
 use super::recorder::{GridSample, Recorder};
 use super::{base_record, stepped_record, Stepped};
 use crate::benchmarks::{self, AnyProblem, Problem};
-use crate::experiment::RunSpec;
 use crate::output::{MethodParts, RunRecord};
 use crate::reference::{self, UlFem};
+use crate::run_spec::RunSpec;
 
 /// Runs `spec`, whose method is a reference method; a benchmark it does not solve makes the
 /// run `failed` with the reason.

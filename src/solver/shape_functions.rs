@@ -7,11 +7,10 @@ use nalgebra::{SMatrix, SVector};
 use super::base_record;
 use super::reconstruction::nan_max;
 use crate::benchmarks::shape_functions::ShapeProblem;
-use crate::experiment::RunSpec;
+use crate::grid::{lattice_coords, Dofs, Grid};
 use crate::output::{RunRecord, RunStatus, ShapeFunctionRecord};
-use crate::shape::{
-    lattice_coords, Dofs, Grid, LinearHat, LmeFailure, LocalMaxEnt, QuadraticBSpline, Shape,
-};
+use crate::run_spec::RunSpec;
+use crate::shape::{LinearHat, LmeFailure, LocalMaxEnt, QuadraticBSpline, Shape};
 use crate::shape_methods::{self, Basis};
 
 /// Neighbours of the centre node recorded on each side along x.
@@ -225,7 +224,7 @@ fn consistency<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::Domain;
+    use crate::grid::Domain;
 
     #[test]
     fn records_the_centre_node_and_its_neighbours_along_x() {

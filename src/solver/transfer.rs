@@ -2,14 +2,18 @@
 
 use nalgebra::SVector;
 
-use crate::integrate::{self, Divergence, FixedDof};
+use crate::divergence::Divergence;
+use crate::grid::FixedDof;
+use crate::grid::Grid;
+use crate::grid::GridState;
+use crate::integrate;
 use crate::methods::TransferKind;
 use crate::particles::Particles;
 use crate::reconstruct::{
-    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, GridState, Lattice,
+    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, Lattice,
     QuadratureTransfer, Reconstructor, TaylorTransfer,
 };
-use crate::shape::{Grid, Shape, Stencils};
+use crate::shape::{Shape, Stencils};
 
 pub enum Transfer<const D: usize> {
     Shepard,

@@ -9,9 +9,9 @@ use super::points::{cell_fractions, check_ppc, Spacing};
 use super::ParamSpec;
 use super::{choice, interval, BenchmarkInfo, Domain, ParamDefault, ParamKind};
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
+use crate::grid::lattice_coords;
 use crate::params::{get_usize, ParamError, Params};
 use crate::rng::Lcg;
-use crate::shape::lattice_coords;
 
 /// More Gauss points per axis than this would only cost time: 32 integrate polynomials of
 /// degree 63 exactly.

@@ -237,7 +237,7 @@ mod tests {
     /// totals: 8 pi for sin(x) + 2 on [0, 4 pi], -6.8691e-1 for sin(x) cos(y) on [0, 5]^2.
     #[test]
     fn box_integrals_match_quadrature_and_the_paper() {
-        let (nodes, weights) = crate::reconstruct::gauss_legendre_rule(10);
+        let (nodes, weights) = crate::gauss::gauss_legendre_rule(10);
         let (a, b) = (0.3, 1.1);
         for f in TestFunction::ALL {
             let sum: f64 = nodes

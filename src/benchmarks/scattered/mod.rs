@@ -19,7 +19,8 @@ pub use points::{place, Spacing};
 use points::check_ppc;
 
 use super::limits::{check_count, check_lattice};
-use super::{BenchmarkInfo, BenchmarkKind, Domain, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
+use crate::grid::Domain;
 use crate::params::{get_f64, get_list, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{Weight, MAX_NODE_SUPPORT_CELLS};
 

@@ -4,7 +4,7 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use super::*;
-use crate::reconstruct::gauss_legendre_rule;
+use crate::gauss::gauss_legendre_rule;
 use crate::rng::Lcg;
 
 /// The integral of `f` over the cell by the `n`-point Gauss rule per axis.

@@ -15,7 +15,9 @@ use std::fmt;
 use nalgebra::SVector;
 
 use super::block::{block_start, for_each_block_node, NODES_PER_AXIS};
-use super::{lattice_coords, lattice_strides, Grid, LinearHat, Shape, Stencils};
+use super::{LinearHat, Shape, Stencils};
+use crate::divergence::DomainFault;
+use crate::grid::{lattice_coords, lattice_strides, Grid};
 use crate::particles::Particles;
 use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
 use gimp::{averaged_hats, hat};
@@ -47,34 +49,6 @@ impl DomainShape {
 impl fmt::Display for DomainShape {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-/// Why the stencils of a particle could not be built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DomainFault {
-    /// The particle (or, for CPDI2, a corner of its domain) left the grid.
-    Outside(usize),
-    /// The domain spans more than `NODES_PER_AXIS - 1` cells along some axis.
-    TooWide(usize),
-    /// The domain has no positive volume (an inverted quadrilateral).
-    Inverted(usize),
-    /// A CPDI2 corner left the grid.
-    CornerOutside(usize),
-}
-
-impl fmt::Display for DomainFault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DomainFault::Outside(p) => write!(f, "particle {p} left the grid"),
-            DomainFault::TooWide(p) => write!(
-                f,
-                "the domain of particle {p} spans more than {} cells",
-                NODES_PER_AXIS - 1
-            ),
-            DomainFault::Inverted(p) => write!(f, "the domain of particle {p} is inverted"),
-            DomainFault::CornerOutside(c) => write!(f, "domain corner {c} left the grid"),
-        }
     }
 }
 
@@ -151,7 +125,7 @@ impl<const D: usize> ParticleDomains<D> {
     ) -> Result<(), DomainFault> {
         if stencils.per_point == Self::narrow_nodes_per_point() {
             match self.fill_blocks::<NARROW_PER_AXIS>(grid, particles, stencils) {
-                Err(DomainFault::TooWide(_)) => stencils.reshape(Self::nodes_per_point()),
+                Err(DomainFault::TooWide { .. }) => stencils.reshape(Self::nodes_per_point()),
                 done => return done,
             }
         }
@@ -178,8 +152,12 @@ impl<const D: usize> ParticleDomains<D> {
                 return Err(DomainFault::Outside(p));
             }
             if let Some(half) = self.box_half_widths(particles, p) {
-                fill_box::<D, A>(grid, &x, &half, node, weight, grad)
-                    .ok_or(DomainFault::TooWide(p))?;
+                fill_box::<D, A>(grid, &x, &half, node, weight, grad).ok_or(
+                    DomainFault::TooWide {
+                        particle: p,
+                        max_cells: NODES_PER_AXIS - 1,
+                    },
+                )?;
                 continue;
             }
             self.corners_of(particles, p, corners);
@@ -187,8 +165,12 @@ impl<const D: usize> ParticleDomains<D> {
                 *corner = clamp_to_grid(grid, corner);
             }
             let cw = corner_weights(corners).ok_or(DomainFault::Inverted(p))?;
-            fill_corners::<D, A>(grid, corners, &cw, node, weight, grad)
-                .ok_or(DomainFault::TooWide(p))?;
+            fill_corners::<D, A>(grid, corners, &cw, node, weight, grad).ok_or(
+                DomainFault::TooWide {
+                    particle: p,
+                    max_cells: NODES_PER_AXIS - 1,
+                },
+            )?;
             if self.shape == DomainShape::Quadrilateral {
                 particles.volume[p] = cw.volume;
             }

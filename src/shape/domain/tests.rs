@@ -3,7 +3,7 @@ use nalgebra::{SMatrix, SVector};
 use super::cpdi::{corner_weights, reference_corner};
 use super::*;
 use crate::benchmarks::{gong_mms, thesis_params, Problem, SineMms};
-use crate::reconstruct::gauss_legendre;
+use crate::gauss::gauss_legendre;
 use crate::rng::Lcg;
 use crate::shape::LinearHat;
 
@@ -22,7 +22,7 @@ fn deformed<const D: usize>(
 ) -> (Grid<D>, Particles<D>, ParticleDomains<D>, Stencils<D>) {
     let problem: SineMms<D> = gong_mms(&thesis_params(0.1, 6, 2)).unwrap();
     let grid = Grid::new(&problem.domain());
-    let mut particles = Particles::seed(&problem, &grid);
+    let mut particles = problem.seed_particles(&grid);
     let mut rng = Lcg::new(seed);
     let mut rand = move || rng.unit() - 0.5;
     let spacing = particles.lattice.spacing;
@@ -307,7 +307,10 @@ fn faults_name_the_particle() {
     particles.f[4] *= 8.0;
     assert_eq!(
         domains.fill(&grid, &mut particles, &mut st),
-        Err(DomainFault::TooWide(4))
+        Err(DomainFault::TooWide {
+            particle: 4,
+            max_cells: NODES_PER_AXIS - 1
+        })
     );
     particles.f[4] = SMatrix::from_diagonal(&SVector::<f64, 2>::new(-1.0, 1.0));
     assert_eq!(

@@ -1,10 +1,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::*;
-use crate::benchmarks::Domain;
+use crate::grid::lattice_coords;
+use crate::grid::Domain;
 use crate::rng::Lcg;
 use crate::shape::stencils::assert_gradient_matches_differences;
-use crate::shape::{lattice_coords, LinearHat, Stencils};
+use crate::shape::{LinearHat, Stencils};
 
 /// The two values of gamma Molinos et al. run.
 const PAPER_GAMMAS: [f64; 2] = [0.8, 3.0];

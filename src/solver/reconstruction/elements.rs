@@ -5,9 +5,10 @@
 use nalgebra::SVector;
 
 use crate::benchmarks::scattered::{ElementData, ExactField};
+use crate::gauss::gauss_legendre_rule;
+use crate::grid::lattice_coords;
 use crate::output::ElementRecord;
-use crate::reconstruct::{gauss_legendre_rule, taylor_terms, Conservation, TaylorCell, TaylorFit};
-use crate::shape::lattice_coords;
+use crate::reconstruct::{taylor_terms, Conservation, TaylorCell, TaylorFit};
 
 /// Plot samples per element along x.
 const CURVE_SAMPLES: usize = 101;

@@ -11,11 +11,11 @@ use nalgebra::SVector;
 use super::base_record;
 use crate::benchmarks::scattered::{ElementProblem, ScatteredData};
 use crate::benchmarks::{self, BenchmarkKind};
-use crate::experiment::RunSpec;
+use crate::grid::Grid;
 use crate::output::{ElementRecord, ReconstructionRecord, RunRecord, RunStatus};
 use crate::reconstruct::{Kernel, Lattice, Recipe, Reconstructor, Solver};
 use crate::reconstruction_methods::{self, Fit, ReconstructionMethod};
-use crate::shape::Grid;
+use crate::run_spec::RunSpec;
 
 /// Samples of u on the interval for plots: smooth enough for sin(pi x) at any scale.
 const CURVE_SAMPLES: usize = 401;

@@ -1,5 +1,6 @@
-//! Gauss-Legendre rules of any order, for integrals that need more points than the tabulated
-//! rules of the lattices (`lattice::gauss_legendre`, 1 to 3 points).
+//! Gauss-Legendre rules on [-1, 1]: the tabulated 1- to 3-point rules of the evaluation
+//! lattices (`gauss_legendre`), and rules of any order (`gauss_legendre_rule`) for integrals
+//! that need more points.
 
 use std::f64::consts::PI;
 
@@ -7,6 +8,18 @@ use std::f64::consts::PI;
 /// rounding); a few more than the usual five or six are allowed for large n.
 const ROOT_TOLERANCE: f64 = 1e-15;
 const MAX_NEWTON_STEPS: usize = 100;
+
+/// Gauss-Legendre abscissae and weights on [-1, 1].
+pub fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
+    const A2: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
+    const A3: f64 = 0.774_596_669_241_483_4; // sqrt(3/5)
+    match n {
+        1 => (&[0.0], &[2.0]),
+        2 => (&[-A2, A2], &[1.0, 1.0]),
+        3 => (&[-A3, 0.0, A3], &[5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]),
+        _ => panic!("Gauss-Legendre rules with 1 to 3 points are tabulated, not {n}"),
+    }
+}
 
 /// Abscissae (ascending) and weights of the `n`-point Gauss-Legendre rule on [-1, 1]: exact for
 /// polynomials of degree 2n - 1. The abscissae are the roots of P_n, found by Newton's method
@@ -56,7 +69,7 @@ fn legendre(n: usize, x: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::lattice::gauss_legendre;
+    use super::gauss_legendre;
     use super::*;
 
     #[test]

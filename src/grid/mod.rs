@@ -1,6 +1,13 @@
+//! The uniform background grid: the box it covers, the numbering of its basis's DOFs, and the
+//! nodal state assembled on them each step.
+
+mod domain;
+mod state;
+
 use nalgebra::SVector;
 
-use crate::benchmarks::Domain;
+pub use domain::Domain;
+pub use state::{FixedDof, GridState};
 
 /// Where the degrees of freedom of the grid's basis sit along each axis. The grid's "nodes"
 /// are these DOFs: nodal masses, velocities and forces live on them.
