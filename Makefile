@@ -146,7 +146,7 @@ test: deps lint build
 	done
 	# After the reports, so that the layout test also checks the figures' data files.
 	step "pytest tests/python (MPMLAB_RESULTS=$(TEST_OUT))"
-	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
+	MPMLAB_RESULTS="$(abspath $(TEST_OUT))" MPMLAB_BIN="$(abspath $(BIN))" "$(VENV_PY)" -m pytest tests/python -q -p no:cacheprovider
 	step "scripts/test-slurm.sh (make test-slurm)"
 	scripts/test-slurm.sh "$(BIN)" "$(VENV_PY)"
 	$(MAKE) --no-print-directory reproduce

@@ -15,14 +15,14 @@ use nalgebra::SVector;
 
 use mpmlab::benchmarks::{self, thesis_params};
 
-use mpmlab::grid::Domain;
-use mpmlab::grid::Grid;
+use mpmlab::grid::{Domain, Grid};
+use mpmlab::integrate::INTEGRATOR_NAMES;
 use mpmlab::methods::{self, GAMMA_KEY, INTEGRATOR_KEY};
 use mpmlab::output::RunStatus;
 use mpmlab::params::{ParamValue, Params};
 use mpmlab::rng::Lcg;
 use mpmlab::run_spec::RunSpec;
-use mpmlab::shape::{LinearHat, LocalMaxEnt, Shape, Stencils};
+use mpmlab::shape::{LinearHat, LocalMaxEnt, Shape, ShapeKind, Stencils};
 use mpmlab::solver::simulate;
 
 /// The system allocator, counting the bytes live and their peak since the last `reset`.
@@ -144,10 +144,12 @@ struct Variant {
 fn variants(filter: Option<&str>) -> Vec<Variant> {
     let mut variants = Vec::new();
     for preset in methods::presets() {
-        if filter.is_some_and(|f| f != preset.name) && preset.name != "mpm" {
+        let skipped = filter.is_some_and(|f| f != preset.name) && preset.name != "mpm";
+        // The composed method is whatever parts a run names: no preset to time.
+        if skipped || preset.name == methods::COMPOSED {
             continue;
         }
-        let is_lme = matches!(preset.method.shape, methods::ShapeKind::LocalMaxEnt(_));
+        let is_lme = matches!(preset.method.shape, ShapeKind::LocalMaxEnt(_));
         if is_lme {
             for gamma in GAMMAS {
                 variants.push(Variant {
@@ -164,7 +166,7 @@ fn variants(filter: Option<&str>) -> Vec<Variant> {
             method_params: Params::new(),
         });
         if preset.name == "mpm" && filter.is_none_or(|f| f == "mpm") {
-            for &integrator in &methods::IntegratorKind::NAMES[1..] {
+            for &integrator in &INTEGRATOR_NAMES[1..] {
                 variants.push(Variant {
                     label: format!("mpm {integrator}"),
                     preset: preset.name,

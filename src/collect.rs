@@ -12,8 +12,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 use crate::benchmarks::BenchmarkKind;
-use crate::experiment::{self, Experiment};
-use crate::experiment::{FigureKind, TableKind};
+use crate::experiment::{self, Experiment, FigureKind, TableKind};
 use crate::output::{
     open_hdf5, open_run_file, read_final_state, read_probes, read_summary, run_path, ParticleState,
     RunSummary, UnreadableRun,

@@ -4,6 +4,7 @@
 //! orders them, and `tests/layers.rs` holds the code to that order.
 
 pub mod benchmarks;
+pub mod catalog;
 pub mod collect;
 pub mod divergence;
 pub mod experiment;

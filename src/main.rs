@@ -3,6 +3,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use serde_json::{json, Value};
+
+use mpmlab::catalog::Catalog;
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
 use mpmlab::output::{remove_dead_temps, write_atomically};
@@ -13,7 +16,8 @@ use mpmlab::runner::{
 use mpmlab::shard::{Plan, Shard};
 use mpmlab::slurm;
 use mpmlab::{
-    benchmarks, experiment, methods, reconstruction_methods, reference, report, shape_methods,
+    benchmarks, experiment, integrate, methods, reconstruct, reconstruction_methods, reference,
+    report, shape, shape_methods,
 };
 
 /// mpmlab: run Material Point Method experiment matrices and report their convergence.
@@ -116,9 +120,18 @@ enum Command {
     /// directories under <dir> beside ours, with verdicts and the figures of each paper item.
     Index { dir: PathBuf },
     /// List the method presets and what they are composed of, and the reconstruction methods.
-    ListMethods,
+    ListMethods {
+        /// Print them as JSON: presets with their parts' names, the parts, the method
+        /// parameters, the reference solvers, reconstruction methods and grid bases.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the benchmarks and their parameters.
-    ListBenchmarks,
+    ListBenchmarks {
+        /// Print them as JSON: each benchmark's name, kind, dimension and parameters.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -176,14 +189,8 @@ fn main() -> ExitCode {
         }),
         Command::Report { dir, check } => report_dir(&dir, check),
         Command::Index { dir } => index(&dir),
-        Command::ListMethods => {
-            list_methods();
-            Ok(())
-        }
-        Command::ListBenchmarks => {
-            list_benchmarks();
-            Ok(())
-        }
+        Command::ListMethods { json } => list(json, methods_json, list_methods),
+        Command::ListBenchmarks { json } => list(json, benchmarks_json, list_benchmarks),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -436,6 +443,120 @@ fn index_entry<'a>(dir: &'a str, c: &'a Collected) -> Result<report::index::Inde
     })
 }
 
+/// A parameter's spec as JSON: its key, kind (with the choices of a `Choice`), default, unit
+/// and documentation.
+fn param_json(p: &benchmarks::ParamSpec) -> Value {
+    let (kind, choices) = match p.kind {
+        benchmarks::ParamKind::Real => ("real", None),
+        benchmarks::ParamKind::PositiveReal => ("positive_real", None),
+        benchmarks::ParamKind::PositiveInt => ("positive_int", None),
+        benchmarks::ParamKind::Choice(names) => ("choice", Some(names)),
+        benchmarks::ParamKind::RealList => ("real_list", None),
+    };
+    let default = match p.default {
+        benchmarks::ParamDefault::Required => Value::Null,
+        benchmarks::ParamDefault::Int(i) => json!(i),
+        benchmarks::ParamDefault::Float(x) => json!(x),
+        benchmarks::ParamDefault::Text(s) => json!(s),
+    };
+    json!({
+        "key": p.key,
+        "kind": kind,
+        "choices": choices,
+        "required": p.default == benchmarks::ParamDefault::Required,
+        "default": default,
+        "unit": p.unit,
+        "doc": p.doc,
+    })
+}
+
+fn parts_json<T>(parts: &Catalog<T>) -> Value {
+    parts
+        .entries
+        .iter()
+        .map(|e| json!({"name": e.name, "description": e.description}))
+        .collect()
+}
+
+/// Everything `list_methods` prints, for tools.
+fn methods_json() -> Value {
+    let presets: Vec<Value> = methods::presets()
+        .iter()
+        .map(|p| {
+            let m = &p.method;
+            json!({
+                "name": p.name,
+                "shape": m.shape.name(),
+                "transfer": reconstruct::TRANSFERS.name_of(&m.transfer),
+                "integrator": m.integrator.name(),
+                "source": p.source,
+                "description": p.description,
+            })
+        })
+        .collect();
+    let named = |name: &str, source: &str, description: &str| json!({"name": name, "source": source, "description": description});
+    json!({
+        "presets": presets,
+        "parts": {
+            "shape": parts_json(&shape::SHAPES),
+            "transfer": parts_json(&reconstruct::TRANSFERS),
+            "integrator": parts_json(&integrate::INTEGRATORS),
+        },
+        "method_params": methods::METHOD_PARAMS.iter().map(param_json).collect::<Vec<_>>(),
+        "reference": reference::methods()
+            .iter()
+            .map(|m| {
+                let mut v = named(m.name, m.source, m.description);
+                v["benchmarks"] = json!(m.benchmarks);
+                v
+            })
+            .collect::<Vec<_>>(),
+        "reconstruction": reconstruction_methods::methods()
+            .iter()
+            .map(|m| named(m.name, m.source, m.description))
+            .collect::<Vec<_>>(),
+        "shape_functions": shape_methods::methods()
+            .iter()
+            .map(|m| named(m.name, m.source, m.description))
+            .collect::<Vec<_>>(),
+    })
+}
+
+/// Every benchmark with its kind, dimension and parameters, for tools.
+fn benchmarks_json() -> Value {
+    benchmarks::catalog()
+        .iter()
+        .map(|b| {
+            json!({
+                "name": b.name,
+                "kind": benchmarks::kind(b).to_string(),
+                "dim": b.dim,
+                "source": b.source,
+                "description": b.description,
+                "params": b.params.iter().map(param_json).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
+}
+
+/// A listing as JSON for tools, or as text.
+fn list(json: bool, as_json: fn() -> Value, as_text: fn()) -> Result<(), String> {
+    if json {
+        let text = serde_json::to_string_pretty(&as_json()).map_err(|e| e.to_string())?;
+        println!("{text}");
+    } else {
+        as_text();
+    }
+    Ok(())
+}
+
+fn print_parts<T>(parts: &Catalog<T>) {
+    println!("{}s:", parts.kind);
+    for part in parts.entries {
+        println!("  {:<20} {}", part.name, part.description);
+    }
+}
+
 fn list_methods() {
     println!("Simulation methods (benchmarks of kind simulation):");
     for preset in methods::presets() {
@@ -445,6 +566,13 @@ fn list_methods() {
         );
         println!("{:<15} {}", "", preset.method);
     }
+    println!(
+        "\nThe parts of a method (the shape, transfer and integrator parameters; a run that sets \
+         all three needs no preset):"
+    );
+    print_parts(&shape::SHAPES);
+    print_parts(&reconstruct::TRANSFERS);
+    print_parts(&integrate::INTEGRATORS);
     println!("\nMethod parameters (in params or as matrix axes of any simulation):");
     for p in methods::METHOD_PARAMS {
         print_param(p);

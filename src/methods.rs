@@ -6,133 +6,17 @@ use std::fmt;
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
 use crate::benchmarks::scattered::MAX_GAUSS_POINTS;
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
-use crate::params::{get_f64, get_str, get_usize, ParamError, Params};
+use crate::catalog::Catalog;
+use crate::integrate::{IntegratorKind, INTEGRATORS, INTEGRATOR_NAMES};
+use crate::params::{get_f64, get_str, get_usize, ParamError, ParamValue, Params};
 use crate::reconstruct::{
-    BodyForceFit, Degree, Kernel, MassMatrix, NodalVelocity, QuadratureRecipe, Recipe, Solver,
-    TaylorRecipe, Weight,
+    BodyForceFit, TransferKind, IMLS, IMLS_CPLS, IMLS_EQ27, IMPM, IMPM_FIELDS, IMPM_VELOCITY, TLS,
+    TLS_LUMPED, TRANSFERS, TRANSFER_NAMES,
 };
-use crate::shape::{DomainShape, DualIntegrals, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
-
-/// Basis functions used on the background grid.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ShapeKind {
-    /// Piecewise-linear hat (tensor product in 2D), Gong eq 4.8.
-    Linear,
-    /// The hat averaged over each particle's domain (GIMP, CPDI; Gong ch. 6).
-    Domain(DomainShape),
-    /// Quadratic B-splines on the open knot vector 0, 0, 0, h, ..., L, L, L (tensor product
-    /// in 2D): cells + 2 DOFs per axis (BSMPM; Steffen et al. 2008, Tielen et al. 2017).
-    QuadraticBSpline,
-    /// The hat's values with the dual-domain gradient, the hat's gradient averaged over the
-    /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011), the integrals taken
-    /// as given.
-    DualDomain(DualIntegrals),
-    /// Local maximum-entropy functions on the grid nodes (Arroyo & Ortiz 2006; Molinos et al.
-    /// sec 5), with the locality gamma and the neighbour cut-off of the run.
-    LocalMaxEnt(LmeSettings),
-}
-
-/// The parameters of the LME basis: gamma = beta h^2 and the prior weight exp(-beta r^2) below
-/// which a node is left out of a point's stencil.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LmeSettings {
-    pub gamma: f64,
-    pub tolerance: f64,
-}
-
-/// How particle data reaches the grid.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum TransferKind {
-    /// Mass-weighted nodal averages (Shepard interpolation with w = M_p N_i), Gong sec 4.3.1.
-    Shepard,
-    /// Least-squares fits evaluated at nodes and quadrature points (IMPM, IMLS-MPM).
-    Quadrature(QuadratureRecipe),
-    /// Mass and forces lumped as in `Shepard`, the nodal velocity a least-squares fit of the
-    /// particle velocities (improved CPDI, Gong sec 6.6).
-    FittedVelocity(Recipe),
-    /// The sums of `Shepard` solved with the consistent mass matrix of the particle
-    /// quadrature, M_ij = sum_p M_p N_ip N_jp, for the velocity (Wobbes et al. eq 8 with the
-    /// full matrix), the acceleration and MUSL's remap.
-    ConsistentMass,
-    /// Taylor least squares per element: stress fitted freely, density and momentum with the
-    /// element's mass and momentum prescribed, integrated by Gauss quadrature (Wobbes et al.
-    /// sec 3).
-    Taylor(TaylorRecipe),
-}
-
-/// How the grid equations are advanced in time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum IntegratorKind {
-    /// Leapfrog with half-step velocities and the particle update of Gong sec 4.4.
-    Leapfrog,
-    /// Whole-step velocities, particles moved first, velocity gradient from the nodal
-    /// velocity rebuilt from the moved particles (Tran eqs 31-40; Sulsky's MUSL).
-    Musl,
-    /// Whole-step velocities, particles kicked and moved with the updated nodal velocity and
-    /// deformed with it (update stress last, no remap): what the CPLS code of Tran et al.
-    /// runs for MPM, CPDI and IMLS-MPM.
-    Usl,
-    /// Sulsky et al. 1994 as Molinos et al. eqs 21-22 write it: whole-step velocities,
-    /// v_p += dt sum_i N_ip a_i, x_p += dt sum_i N_ip v_i with the start-of-step nodal
-    /// velocity, the stress from the updated nodal velocity v_i + dt a_i.
-    Euler,
-    /// Eqs 23-24 (Zhang et al. 2016): the particle update of eqs 21-22 written with nodal
-    /// momenta, and the stress from the nodal velocity rebuilt from the updated particle
-    /// velocities, which stays bounded where a nodal mass vanishes.
-    EulerCorrected,
-    /// The explicit Newmark predictor-corrector (gamma = 1/2) of Molinos et al. sec 4 as the
-    /// authors' code runs it: the predictor mapped from the particles' v_p + dt/2 a_p every
-    /// step, the stress from it, the corrector with half the new acceleration
-    /// (`integrate::predictor_corrector`).
-    PredictorCorrector,
-}
-
-impl IntegratorKind {
-    /// The names the `integrator` parameter takes, in the order of `ALL`.
-    pub const NAMES: &'static [&'static str] = &[
-        "leapfrog",
-        "musl",
-        "usl",
-        "euler",
-        "euler_corrected",
-        "predictor_corrector",
-    ];
-    const ALL: [IntegratorKind; 6] = [
-        IntegratorKind::Leapfrog,
-        IntegratorKind::Musl,
-        IntegratorKind::Usl,
-        IntegratorKind::Euler,
-        IntegratorKind::EulerCorrected,
-        IntegratorKind::PredictorCorrector,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            IntegratorKind::Leapfrog => Self::NAMES[0],
-            IntegratorKind::Musl => Self::NAMES[1],
-            IntegratorKind::Usl => Self::NAMES[2],
-            IntegratorKind::Euler => Self::NAMES[3],
-            IntegratorKind::EulerCorrected => Self::NAMES[4],
-            IntegratorKind::PredictorCorrector => Self::NAMES[5],
-        }
-    }
-
-    fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name)
-    }
-
-    /// Whether the particles carry v^{s-1/2} between steps and start with a half kick: the
-    /// leapfrog alone.
-    pub fn staggers_velocity(self) -> bool {
-        self == IntegratorKind::Leapfrog
-    }
-
-    /// Whether the strain rate comes from the nodal velocity rebuilt from the moved
-    /// particles (MUSL, eqs 23-24) rather than from the grid solve's.
-    pub fn remaps_velocity(self) -> bool {
-        matches!(self, IntegratorKind::Musl | IntegratorKind::EulerCorrected)
-    }
-}
+use crate::shape::{
+    DomainShape, DualIntegrals, LmeParamError, LmeSettings, LocalMaxEnt, ShapeKind,
+    DEFAULT_TOLERANCE, LME_UNSET, SHAPES, SHAPE_NAMES,
+};
 
 /// Which particle velocity a sample records for the whole-step schemes MUSL and USL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,7 +60,7 @@ impl Method {
 
     /// Whether the basis takes the particles' domains from the seed lattice's sub-cells.
     pub fn reads_seed_domains(&self) -> bool {
-        matches!(self.shape, ShapeKind::Domain(_))
+        self.shape.reads_seed_domains()
     }
 }
 
@@ -186,72 +70,6 @@ pub struct MethodPreset {
     pub source: &'static str,
     pub description: &'static str,
 }
-
-const fn recipe(weight: Weight, scale: f64, solver: Solver) -> Recipe {
-    Recipe {
-        kernel: Kernel { weight, scale },
-        degree: Degree::LINEAR,
-        solver,
-    }
-}
-
-/// Gong sec 5.3, eq 5.6: the nodal velocity by linear MLS with the cubic spline.
-const IMPM_VELOCITY: Recipe = recipe(Weight::CubicSpline, 1.0, Solver::Mls);
-
-/// Gong sec 5.3: velocity by linear MLS with the cubic spline, density, stress and body
-/// force by linear MLS with the quadratic spline at the cell centres.
-const IMPM: QuadratureRecipe = QuadratureRecipe {
-    velocity: NodalVelocity::Fit(IMPM_VELOCITY),
-    fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Mls),
-    gauss_points: 1,
-    body_force: BodyForceFit::Separate,
-};
-
-/// IMPM's field fits and cell-centre quadrature (Gong eqs 5.7-5.14) with the original MPM's
-/// mass-weighted nodal velocity in place of eq 5.6: the field half of IMPM alone.
-const IMPM_FIELDS: QuadratureRecipe = QuadratureRecipe {
-    velocity: NodalVelocity::Shepard,
-    ..IMPM
-};
-
-/// Tran eqs 24-31: velocity by IMLS with the hat weight, density, stress and body force by
-/// IMLS with the quadratic spline at 2 Gauss points per cell and axis, which integrate
-/// N_i times a linear field exactly. The quadratic spline is scaled with h as Gong does;
-/// `imls_eq27` scales it with 2h as Tran's eq 27 prints.
-const IMLS: QuadratureRecipe = QuadratureRecipe {
-    velocity: NodalVelocity::Fit(recipe(Weight::Hat, 1.0, Solver::Imls)),
-    fields: recipe(Weight::QuadraticSpline, 1.0, Solver::Imls),
-    gauss_points: 2,
-    body_force: BodyForceFit::Separate,
-};
-
-/// IMLS-MPM as the CPLS code of Tran et al. runs it (`Compute_Interpolator_IMLS_MPM`,
-/// `Interpolate_Particle_To_Grid_MLS`): the fields at the cell centre (one point per cell),
-/// the body force as one fit of rho_p b_p.
-const IMLS_CPLS: QuadratureRecipe = QuadratureRecipe {
-    gauss_points: 1,
-    body_force: BodyForceFit::Product,
-    ..IMLS
-};
-
-const IMLS_EQ27: QuadratureRecipe = QuadratureRecipe {
-    fields: recipe(Weight::QuadraticSpline, 2.0, Solver::Imls),
-    ..IMLS
-};
-
-/// Wobbes et al. sec 5: quadratic TLS (n_b = 3 in 1D), two Gauss points per element and
-/// axis, velocity and acceleration solved with the consistent mass matrix (eqs 9-11).
-const TLS: TaylorRecipe = TaylorRecipe {
-    degree: 2,
-    gauss_points: 2,
-    mass: MassMatrix::Consistent,
-};
-
-/// TLS with the lumped mass matrix, which sec 3 allows without losing conservation.
-const TLS_LUMPED: TaylorRecipe = TaylorRecipe {
-    mass: MassMatrix::Lumped,
-    ..TLS
-};
 
 const fn on_domains(
     shape: DomainShape,
@@ -442,10 +260,7 @@ const PRESETS: &[MethodPreset] = &[
     MethodPreset {
         name: "lme",
         method: Method {
-            shape: ShapeKind::LocalMaxEnt(LmeSettings {
-                gamma: f64::NAN,
-                tolerance: DEFAULT_TOLERANCE,
-            }),
+            shape: LME_UNSET,
             transfer: TransferKind::Shepard,
             integrator: IntegratorKind::PredictorCorrector,
             sampled_velocity: SampledVelocity::Stepped,
@@ -521,7 +336,23 @@ const PRESETS: &[MethodPreset] = &[
         description:
             "dual-domain MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
     },
+    MethodPreset {
+        name: COMPOSED,
+        method: Method {
+            shape: ShapeKind::Linear,
+            transfer: TransferKind::Shepard,
+            integrator: IntegratorKind::Leapfrog,
+            sampled_velocity: SampledVelocity::Stepped,
+        },
+        source: "the run's parts",
+        description: "the composition of the run's shape, transfer and integrator (all three \
+                      required; `mpmlab list-methods` lists each part)",
+    },
 ];
+
+/// The preset that is no preset: a method composed of the run's `shape`, `transfer` and
+/// `integrator` alone.
+pub const COMPOSED: &str = "composed";
 
 pub fn presets() -> &'static [MethodPreset] {
     PRESETS
@@ -535,6 +366,8 @@ pub fn preset_names() -> Vec<&'static str> {
     PRESETS.iter().map(|p| p.name).collect()
 }
 
+pub const SHAPE_KEY: &str = "shape";
+pub const TRANSFER_KEY: &str = "transfer";
 pub const GAMMA_KEY: &str = "gamma";
 pub const LME_TOLERANCE_KEY: &str = "lme_tolerance";
 pub const INTEGRATOR_KEY: &str = "integrator";
@@ -546,6 +379,21 @@ pub const SAMPLED_VELOCITY_KEY: &str = "sampled_velocity";
 /// of any simulation. They have no defaults that enter a run: a run that does not set them has
 /// none in its configuration, so run ids of methods that do not use them do not change.
 pub const METHOD_PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        key: SHAPE_KEY,
+        kind: ParamKind::Choice(&SHAPE_NAMES),
+        default: ParamDefault::Text("the preset's"),
+        unit: "",
+        doc: "shape function in place of the preset's (`mpmlab list-methods` describes each)",
+    },
+    ParamSpec {
+        key: TRANSFER_KEY,
+        kind: ParamKind::Choice(&TRANSFER_NAMES),
+        default: ParamDefault::Text("the preset's"),
+        unit: "",
+        doc: "particle-to-grid transfer in place of the preset's (`mpmlab list-methods` \
+              describes each)",
+    },
     ParamSpec {
         key: GAMMA_KEY,
         kind: ParamKind::PositiveReal,
@@ -562,7 +410,7 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         key: INTEGRATOR_KEY,
-        kind: ParamKind::Choice(IntegratorKind::NAMES),
+        kind: ParamKind::Choice(&INTEGRATOR_NAMES),
         default: ParamDefault::Text("the preset's"),
         unit: "",
         doc: "time integrator in place of the preset's (not for the TLS transfers, which solve \
@@ -600,6 +448,31 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
 /// are valid in `dim` dimensions.
 pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Method, ParamError> {
     let mut method = preset.method;
+    let parts = [SHAPE_KEY, TRANSFER_KEY, INTEGRATOR_KEY];
+    if preset.name == COMPOSED {
+        if let Some(key) = parts.iter().find(|key| !params.contains_key(**key)) {
+            return Err(ParamError::new(
+                "method",
+                format!(
+                    "method {COMPOSED} needs {}: {key} is not set",
+                    parts.join(", ")
+                ),
+            ));
+        }
+    }
+    if let Some(shape) = named_part(params, SHAPE_KEY, &SHAPES)? {
+        method.shape = shape;
+    }
+    if let Some(transfer) = named_part(params, TRANSFER_KEY, &TRANSFERS)? {
+        method.transfer = transfer;
+    }
+    if let Err(reason) = check_parts(&method) {
+        let key = parts[..2]
+            .iter()
+            .find(|key| params.contains_key(**key))
+            .unwrap_or(&"method");
+        return Err(ParamError::new(key, reason));
+    }
     if let ShapeKind::LocalMaxEnt(lme) = &mut method.shape {
         if !params.contains_key(GAMMA_KEY) {
             // Placed at the method, which is what was written.
@@ -626,20 +499,8 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
             |m| matches!(m.shape, ShapeKind::LocalMaxEnt(_)),
         )?;
     }
-    if params.contains_key(INTEGRATOR_KEY) {
-        let name = get_str(params, INTEGRATOR_KEY)?;
-        let integrator = IntegratorKind::from_name(name).ok_or_else(|| {
-            ParamError::new(
-                INTEGRATOR_KEY,
-                format!(
-                    "unknown integrator '{name}'; valid: {}",
-                    IntegratorKind::NAMES.join(", ")
-                ),
-            )
-        })?;
-        if integrator != preset.method.integrator {
-            check_integrator(preset, integrator)?;
-        }
+    if let Some(integrator) = named_part(params, INTEGRATOR_KEY, &INTEGRATORS)? {
+        check_integrator(preset, &method, integrator)?;
         method.integrator = integrator;
     }
     if params.contains_key(SAMPLED_VELOCITY_KEY) {
@@ -672,6 +533,29 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
         )?;
     }
     Ok(method)
+}
+
+/// The part the run names under `key`, looked up in `parts`; `None` where it names none.
+fn named_part<T: Copy>(
+    params: &Params,
+    key: &str,
+    parts: &Catalog<T>,
+) -> Result<Option<T>, ParamError> {
+    if !params.contains_key(key) {
+        return Ok(None);
+    }
+    let name = get_str(params, key)?;
+    let entry = parts.get(name).map_err(|e| ParamError::new(key, e))?;
+    Ok(Some(entry.value))
+}
+
+/// The shape function of a run of `method` with `params`: the run's `shape` where it names a
+/// known one, the preset's otherwise.
+pub fn run_shape(method: &str, params: &Params) -> Option<ShapeKind> {
+    match params.get(SHAPE_KEY) {
+        Some(ParamValue::Str(name)) => SHAPES.find(name).map(|e| e.value),
+        _ => preset(method).map(|p| p.method.shape),
+    }
 }
 
 /// The run's `sampled_velocity`, which only the whole-step schemes MUSL and USL have a choice of.
@@ -726,34 +610,83 @@ fn refuse(
     }
 }
 
-/// Refuses an `integrator` the preset's transfer cannot run, naming the presets that can.
-fn check_integrator(preset: &MethodPreset, integrator: IntegratorKind) -> Result<(), ParamError> {
-    if runs_with(&preset.method, integrator) {
+/// Refuses an `integrator` the method's transfer cannot run, naming the presets and the
+/// transfers that can.
+fn check_integrator(
+    preset: &MethodPreset,
+    method: &Method,
+    integrator: IntegratorKind,
+) -> Result<(), ParamError> {
+    if runs_with(&method.transfer, integrator) {
         return Ok(());
     }
+    let transfers: Vec<&str> = TRANSFERS
+        .entries
+        .iter()
+        .filter(|e| runs_with(&e.value, integrator))
+        .map(|e| e.name)
+        .collect();
+    let mapping = match TRANSFERS.name_of(&method.transfer) {
+        Some(name) if preset.name == COMPOSED => format!("the {name} transfer"),
+        _ => format!("{} maps with {}", preset.name, method.transfer),
+    };
     Err(ParamError::new(
         INTEGRATOR_KEY,
         format!(
-            "{} maps with {}, which cannot run {integrator}; {integrator} runs with the methods \
-             {}",
-            preset.name,
-            preset.method.transfer,
-            preset_names_where(|m| runs_with(m, integrator)).join(", ")
+            "{mapping}, which cannot run {integrator}; {integrator} runs with the methods {} (the \
+             transfers {})",
+            preset_names_where(|m| runs_with(&m.transfer, integrator)).join(", "),
+            transfers.join(", ")
         ),
     ))
 }
 
-/// Whether `method`'s transfer can run `integrator`: the TLS and consistent-mass transfers
-/// solve the grid with their own mass matrix, so they keep their integrator; the predictor-corrector maps its
+/// Whether `transfer` can run `integrator`: the TLS and consistent-mass transfers solve the
+/// grid with their own mass matrix inside MUSL's steps; the predictor-corrector maps its
 /// predictor with the Shepard transfer.
-fn runs_with(method: &Method, integrator: IntegratorKind) -> bool {
-    match method.transfer {
-        TransferKind::Taylor(_) | TransferKind::ConsistentMass => integrator == method.integrator,
+fn runs_with(transfer: &TransferKind, integrator: IntegratorKind) -> bool {
+    match transfer {
+        TransferKind::Taylor(_) | TransferKind::ConsistentMass => {
+            integrator == IntegratorKind::Musl
+        }
         TransferKind::Shepard => true,
         TransferKind::Quadrature(_) | TransferKind::FittedVelocity(_) => {
             integrator != IntegratorKind::PredictorCorrector
         }
     }
+}
+
+/// Why a shape function and a transfer cannot run together, if they cannot.
+pub fn check_parts(method: &Method) -> Result<(), String> {
+    let shape = method.shape.name();
+    let transfer = TRANSFERS
+        .name_of(&method.transfer)
+        .unwrap_or("this transfer");
+    let allowed: &[&str] = match method.transfer {
+        // The fits evaluate the hat at their own quadrature points.
+        TransferKind::Quadrature(_) => &["linear"],
+        // The velocity is fitted at the grid nodes, which the B-spline's DOFs are not.
+        TransferKind::FittedVelocity(_) => &[
+            "linear",
+            "ugimp",
+            "cpgimp",
+            "cpdi1",
+            "cpdi2",
+            "dual_domain",
+            "dual_domain_cells",
+            "lme",
+        ],
+        TransferKind::ConsistentMass | TransferKind::Taylor(_) | TransferKind::Shepard => {
+            return Ok(())
+        }
+    };
+    if allowed.contains(&shape) {
+        return Ok(());
+    }
+    Err(format!(
+        "the {transfer} transfer cannot run on the {shape} shape function; it runs on {}",
+        allowed.join(", ")
+    ))
 }
 
 /// The quadrature transfers fit the fields at `gauss_points` per cell and axis of the grid:
@@ -800,44 +733,9 @@ fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {
 fn preset_names_where(keep: impl Fn(&Method) -> bool) -> Vec<&'static str> {
     PRESETS
         .iter()
-        .filter(|p| keep(&p.method))
+        .filter(|p| p.name != COMPOSED && keep(&p.method))
         .map(|p| p.name)
         .collect()
-}
-
-impl fmt::Display for ShapeKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ShapeKind::Linear => f.write_str("linear"),
-            ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
-            ShapeKind::QuadraticBSpline => f.write_str("quadratic-bspline"),
-            ShapeKind::DualDomain(DualIntegrals::Particles) => {
-                f.write_str("dual-domain(particles)")
-            }
-            ShapeKind::DualDomain(DualIntegrals::ActiveCells) => f.write_str("dual-domain(cells)"),
-            ShapeKind::LocalMaxEnt(lme) => {
-                write!(f, "lme(gamma={}, tolerance={})", lme.gamma, lme.tolerance)
-            }
-        }
-    }
-}
-
-impl fmt::Display for TransferKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TransferKind::Shepard => f.write_str("shepard"),
-            TransferKind::ConsistentMass => f.write_str("consistent-mass"),
-            TransferKind::Quadrature(recipe) => write!(f, "quadrature({recipe})"),
-            TransferKind::FittedVelocity(recipe) => write!(f, "fitted-velocity({recipe})"),
-            TransferKind::Taylor(recipe) => write!(f, "taylor({recipe})"),
-        }
-    }
-}
-
-impl fmt::Display for IntegratorKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
 }
 
 impl fmt::Display for Method {
@@ -858,13 +756,98 @@ impl fmt::Display for Method {
 mod tests {
     use super::*;
 
-    #[test]
-    fn every_integrator_is_found_by_its_name() {
-        for kind in IntegratorKind::ALL {
-            assert_eq!(IntegratorKind::from_name(kind.name()), Some(kind));
+    fn params(entries: &[(&str, ParamValue)]) -> Params {
+        let mut p: Params = [("cells".to_string(), ParamValue::Int(8))].into();
+        p.extend(entries.iter().map(|(k, v)| (k.to_string(), v.clone())));
+        p
+    }
+
+    fn text(s: &str) -> ParamValue {
+        ParamValue::Str(s.into())
+    }
+
+    /// The parameters that name a preset's parts, and the gamma an LME basis needs.
+    fn parts_of(preset: &MethodPreset) -> Params {
+        let m = &preset.method;
+        let mut p = params(&[
+            (SHAPE_KEY, text(m.shape.name())),
+            (TRANSFER_KEY, text(TRANSFERS.name_of(&m.transfer).unwrap())),
+            (INTEGRATOR_KEY, text(m.integrator.name())),
+        ]);
+        if m.shape.name() == "lme" {
+            p.insert(GAMMA_KEY.into(), ParamValue::Float(3.0));
         }
-        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
-        assert_eq!(names, IntegratorKind::NAMES);
-        assert_eq!(IntegratorKind::from_name("rk4"), None);
+        p
+    }
+
+    #[test]
+    fn every_preset_is_the_composition_of_its_named_parts() {
+        let composed = preset(COMPOSED).unwrap();
+        for preset in presets().iter().filter(|p| p.name != COMPOSED) {
+            let parts = parts_of(preset);
+            let mut own = params(&[]);
+            own.extend(
+                parts
+                    .get(GAMMA_KEY)
+                    .map(|g| (GAMMA_KEY.to_string(), g.clone())),
+            );
+            for dim in [1, 2] {
+                assert_eq!(
+                    resolve(composed, &parts, dim),
+                    resolve(preset, &own, dim),
+                    "{}",
+                    preset.name
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_part_given_beside_a_preset_replaces_the_presets() {
+        let mpm = preset("mpm").unwrap();
+        let method = resolve(mpm, &params(&[(TRANSFER_KEY, text("mls_velocity"))]), 1).unwrap();
+        assert_eq!(method.transfer, TransferKind::FittedVelocity(IMPM_VELOCITY));
+        assert_eq!(
+            (method.shape, method.integrator),
+            (ShapeKind::Linear, mpm.method.integrator)
+        );
+        let method = resolve(mpm, &params(&[(SHAPE_KEY, text("cpdi2"))]), 2).unwrap();
+        assert_eq!(method.shape, ShapeKind::Domain(DomainShape::Quadrilateral));
+    }
+
+    #[test]
+    fn parts_that_cannot_run_together_are_refused_with_the_reason() {
+        let imls = preset("imls").unwrap();
+        let e = resolve(imls, &params(&[(SHAPE_KEY, text("quadratic_bspline"))]), 1).unwrap_err();
+        assert_eq!(e.key, SHAPE_KEY);
+        assert!(
+            e.message
+                .contains("the imls transfer cannot run on the quadratic_bspline shape")
+                && e.message.ends_with("it runs on linear"),
+            "{}",
+            e.message
+        );
+        let composed = preset(COMPOSED).unwrap();
+        let tls_leapfrog = params(&[
+            (SHAPE_KEY, text("linear")),
+            (TRANSFER_KEY, text("tls")),
+            (INTEGRATOR_KEY, text("leapfrog")),
+        ]);
+        let e = resolve(composed, &tls_leapfrog, 1).unwrap_err();
+        assert_eq!(e.key, INTEGRATOR_KEY);
+        assert!(
+            e.message
+                .starts_with("the tls transfer, which cannot run leapfrog;"),
+            "{}",
+            e.message
+        );
+        let e = resolve(composed, &params(&[(SHAPE_KEY, text("linear"))]), 1).unwrap_err();
+        assert_eq!(e.key, "method");
+        assert!(e.message.contains("transfer is not set"), "{}", e.message);
+        let e = resolve(imls, &params(&[(TRANSFER_KEY, text("flip"))]), 1).unwrap_err();
+        assert_eq!(e.key, TRANSFER_KEY);
+        assert!(e
+            .message
+            .starts_with("unknown transfer 'flip'; valid: shepard,"));
     }
 }

@@ -144,7 +144,9 @@ fn resolve(
     sampling: &Sampling,
 ) -> Result<RunSpec, ConfigError> {
     let mut params = defaults.clone();
-    let mut method = String::new();
+    // Without a preset, the method is the one the run's parts compose (`require_given`
+    // checked that a simulation without one names them all).
+    let mut method = methods::COMPOSED.to_string();
     let mut axes = Params::new();
     let mut id_axes = Vec::new();
     for c in chosen {
@@ -223,7 +225,7 @@ fn check_method_params(
 /// particles' domains, which only sub-cell centres sit in the middle of.
 fn placement_conflict(method: &str, params: &Params) -> Option<ParamError> {
     let gauss = params.get(PLACEMENT_KEY) == Some(&ParamValue::Str(GAUSS_PLACEMENT.into()));
-    let domains = methods::preset(method).is_some_and(|p| p.method.reads_seed_domains());
+    let domains = methods::run_shape(method, params).is_some_and(|s| s.reads_seed_domains());
     (gauss && domains).then(|| {
         ParamError::new(
             PLACEMENT_KEY,

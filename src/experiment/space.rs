@@ -9,7 +9,7 @@
 use std::collections::HashMap;
 
 use crate::benchmarks::{self, BenchmarkInfo, ParamDefault};
-use crate::methods;
+use crate::methods::{self, INTEGRATOR_KEY, SHAPE_KEY, TRANSFER_KEY};
 use crate::params::ParamValue;
 
 use super::document::Sections;
@@ -115,7 +115,12 @@ impl ParamSpace {
                 ),
             )
         };
-        if !self.is_given(METHOD_KEY) {
+        // A simulation that names all three parts of its method needs no preset.
+        let composed = benchmarks::kind(info).steps()
+            && [SHAPE_KEY, TRANSFER_KEY, INTEGRATOR_KEY]
+                .iter()
+                .all(|key| self.is_given(key));
+        if !self.is_given(METHOD_KEY) && !composed {
             let valid = method_names(benchmarks::kind(info));
             return Err(missing(METHOD_KEY).with_valid(valid));
         }
@@ -197,7 +202,8 @@ fn read_matrix(
     for (i, item) in items.iter().enumerate() {
         let mut block = read_block(item, &item_field("matrix", i), info, fixed)?;
         if let Some(first) = blocks.first() {
-            align(&mut block, first, &item_field("matrix", i))?;
+            let composable = benchmarks::kind(info).steps();
+            align(&mut block, first, &item_field("matrix", i), composable)?;
         }
         blocks.push(block);
     }
@@ -205,16 +211,25 @@ fn read_matrix(
 }
 
 /// Puts `block`'s axes in the order of `first`'s (axes `first` lacks last), which must have
-/// the same keys apart from method parameters: every run then has a value for every axis but
-/// those that apply to some methods only (`gamma` for LME), which a block of other methods
-/// leaves out.
-fn align(block: &mut Block, first: &Block, field: &str) -> Result<(), ConfigError> {
+/// the same keys apart from the method and its parameters: every run then has a value for
+/// every axis but those that apply to some methods only (`gamma` for LME), which a block of
+/// other methods leaves out, and, where methods are `composable` from their parts
+/// (simulations), the method, which a block that names the parts instead leaves out.
+fn align(
+    block: &mut Block,
+    first: &Block,
+    field: &str,
+    composable: bool,
+) -> Result<(), ConfigError> {
     let keys = |b: &Block| {
         let mut keys: Vec<String> = b
             .axes
             .iter()
             .map(|a| a.key.clone())
-            .filter(|key| !methods::METHOD_PARAMS.iter().any(|p| p.key == key))
+            .filter(|key| {
+                let method_part = composable && key == METHOD_KEY;
+                !method_part && !methods::METHOD_PARAMS.iter().any(|p| p.key == key)
+            })
             .collect();
         keys.sort();
         keys
@@ -224,8 +239,13 @@ fn align(block: &mut Block, first: &Block, field: &str) -> Result<(), ConfigErro
             block.pos,
             field,
             format!(
-                "every block of the matrix lists the same axes, apart from the method \
-                 parameters ({}); this one has [{}], the first has [{}]",
+                "every block of the matrix lists the same axes, apart from {} ({}); this one \
+                 has [{}], the first has [{}]",
+                if composable {
+                    "the method and its parameters"
+                } else {
+                    "the method parameters"
+                },
                 method_param_keys().join(", "),
                 keys(block).join(", "),
                 keys(first).join(", ")

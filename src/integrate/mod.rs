@@ -1,6 +1,7 @@
 //! Time integration: the grid solve and the particle update.
 
 mod deform;
+mod kind;
 pub mod leapfrog;
 pub mod musl;
 pub mod predictor_corrector;
@@ -8,6 +9,7 @@ pub mod predictor_corrector;
 use nalgebra::SVector;
 
 pub use deform::deform_particles;
+pub use kind::{IntegratorKind, INTEGRATORS, INTEGRATOR_NAMES};
 
 use crate::grid::{FixedDof, GridState};
 

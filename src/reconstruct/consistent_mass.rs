@@ -10,8 +10,7 @@ use nalgebra::SVector;
 use super::mass_matrix::{MassMatrix, MassSolver};
 use super::shepard::{momentum_sums, particle_sums};
 use crate::divergence::Divergence;
-use crate::grid::FixedDof;
-use crate::grid::GridState;
+use crate::grid::{FixedDof, GridState};
 use crate::particles::Particles;
 use crate::shape::Stencils;
 
@@ -75,8 +74,7 @@ impl<const D: usize> ConsistentMassTransfer<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Domain;
-    use crate::grid::{Dofs, Grid};
+    use crate::grid::{Dofs, Domain, Grid};
     use crate::particles::SeedLattice;
     use crate::reconstruct::remap_velocity;
     use crate::shape::{QuadraticBSpline, Shape};

@@ -11,8 +11,7 @@ use super::conjugate_gradients::{
 use super::diagonals::SymmetricDiagonals;
 use super::line_sums::LineSums;
 use crate::divergence::Divergence;
-use crate::grid::FixedDof;
-use crate::grid::GridState;
+use crate::grid::{FixedDof, GridState};
 
 /// Which mass matrix the nodal velocity and acceleration are solved with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -8,6 +8,7 @@ mod conjugate_gradients;
 mod consistent_mass;
 mod diagonals;
 mod kernel;
+mod kind;
 mod lattice;
 mod least_squares;
 mod line_sums;
@@ -23,6 +24,10 @@ mod tests;
 pub use basis::{monomials, Degree, MAX_TERMS};
 pub use consistent_mass::ConsistentMassTransfer;
 pub use kernel::{Kernel, Weight};
+pub use kind::{
+    TransferKind, IMLS, IMLS_CPLS, IMLS_EQ27, IMPM, IMPM_FIELDS, IMPM_VELOCITY, TLS, TLS_LUMPED,
+    TRANSFERS, TRANSFER_NAMES,
+};
 pub use lattice::Lattice;
 pub use least_squares::{
     FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,

@@ -12,8 +12,7 @@ use num_traits::Zero;
 
 use super::shepard::{map_velocity, remap_velocity};
 use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments};
-use crate::grid::Grid;
-use crate::grid::GridState;
+use crate::grid::{Grid, GridState};
 use crate::particles::Particles;
 use crate::shape::{LinearHat, Shape, Stencils};
 
@@ -282,7 +281,7 @@ mod tests {
         methods::presets()
             .iter()
             .filter_map(|p| match p.method.transfer {
-                crate::methods::TransferKind::Quadrature(r) => Some(r),
+                crate::reconstruct::TransferKind::Quadrature(r) => Some(r),
                 _ => None,
             })
             .collect()
@@ -342,7 +341,7 @@ mod tests {
 
     fn preset_recipe(name: &str) -> QuadratureRecipe {
         match methods::preset(name).unwrap().method.transfer {
-            crate::methods::TransferKind::Quadrature(r) => r,
+            crate::reconstruct::TransferKind::Quadrature(r) => r,
             other => panic!("{name} maps with {other}"),
         }
     }

@@ -15,9 +15,7 @@ use super::taylor::{Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
 use super::FitStats;
 use crate::divergence::Divergence;
 use crate::gauss::gauss_legendre_rule;
-use crate::grid::FixedDof;
-use crate::grid::GridState;
-use crate::grid::{lattice_coords, Grid};
+use crate::grid::{lattice_coords, FixedDof, Grid, GridState};
 use crate::particles::Particles;
 use crate::shape::{Shape, Stencils};
 

@@ -3,8 +3,7 @@
 use nalgebra::SVector;
 
 use super::*;
-use crate::grid::Domain;
-use crate::grid::Grid;
+use crate::grid::{Domain, Grid};
 use crate::rng::Lcg;
 
 fn grid<const D: usize>(cells: usize) -> Grid<D> {

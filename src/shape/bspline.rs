@@ -102,8 +102,7 @@ mod tests {
     use nalgebra::SMatrix;
 
     use super::*;
-    use crate::grid::lattice_coords;
-    use crate::grid::Domain;
+    use crate::grid::{lattice_coords, Domain};
     use crate::shape::stencils::assert_gradient_matches_differences;
     use crate::shape::Stencils;
 

@@ -313,8 +313,7 @@ mod tests {
     use nalgebra::SMatrix;
 
     use super::*;
-    use crate::grid::lattice_coords;
-    use crate::grid::Domain;
+    use crate::grid::{lattice_coords, Domain};
     use crate::rng::Lcg;
     use crate::shape::Stencils;
 

@@ -4,6 +4,7 @@ mod block;
 mod bspline;
 mod domain;
 mod dual_domain;
+mod kind;
 mod linear;
 mod lme;
 mod stencils;
@@ -15,6 +16,7 @@ use crate::grid::Grid;
 pub use bspline::QuadraticBSpline;
 pub use domain::{DomainShape, ParticleDomains};
 pub use dual_domain::{DualDomain, DualIntegrals};
+pub use kind::{LmeSettings, ShapeKind, LME_UNSET, SHAPES, SHAPE_NAMES};
 pub use linear::LinearHat;
 pub use lme::{
     LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, MAX_STENCIL_NODES,

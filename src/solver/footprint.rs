@@ -9,11 +9,13 @@
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
 use crate::grid::{Dofs, Grid};
-use crate::methods::{self, Method, ShapeKind, TransferKind};
+use crate::methods::{self, Method};
 use crate::params::get_usize;
-use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe};
+use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe, TransferKind};
 use crate::run_spec::RunSpec;
-use crate::shape::{DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape};
+use crate::shape::{
+    DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape, ShapeKind,
+};
 
 /// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
 /// growing dataset).

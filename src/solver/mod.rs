@@ -15,17 +15,16 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
 use crate::divergence::Divergence;
-use crate::grid::FixedDof;
-use crate::grid::GridState;
-use crate::grid::{Dofs, Grid};
+use crate::grid::{Dofs, FixedDof, Grid, GridState};
 use crate::integrate::predictor_corrector::PredictorCorrector;
-use crate::integrate::{self, leapfrog, musl};
-use crate::methods::{self, IntegratorKind, Method, ShapeKind};
+use crate::integrate::{self, leapfrog, musl, IntegratorKind};
+use crate::methods::{self, Method};
 use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
 use crate::parallel;
 use crate::particles::Particles;
 use crate::reconstruct::{nodal_forces, FitStats};
 use crate::run_spec::RunSpec;
+use crate::shape::ShapeKind;
 use crate::shape::{
     DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape, Stencils,
 };

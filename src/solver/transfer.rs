@@ -3,12 +3,10 @@
 use nalgebra::SVector;
 
 use crate::divergence::Divergence;
-use crate::grid::FixedDof;
-use crate::grid::Grid;
-use crate::grid::GridState;
+use crate::grid::{FixedDof, Grid, GridState};
 use crate::integrate;
-use crate::methods::TransferKind;
 use crate::particles::Particles;
+use crate::reconstruct::TransferKind;
 use crate::reconstruct::{
     particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, Lattice,
     QuadratureTransfer, Reconstructor, TaylorTransfer,

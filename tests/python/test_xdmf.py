@@ -6,7 +6,7 @@ times, one vertex per particle at the sampled positions (z = 0, and y = 0 in 1D)
 per-sample dataset of /history and /errors, at every sample of every such run file, 1D and 2D,
 all bit for bit.
 
-The run files are those of test_h5_layout.py (`make test` runs the reduced matrices first).
+The run files are those of the layout tests (layout.py) (`make test` runs the reduced matrices first).
 """
 
 import h5py
@@ -17,7 +17,7 @@ from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkIOXdmf2 import vtkXdmfReader
 
-from test_h5_layout import ENV, RUN_FILES, _file_id
+from layout import ENV, RUN_FILES, _file_id
 
 # Point array name -> run file dataset: the whole (samples x particles x ...) histories.
 FIELDS = {

@@ -1,8 +1,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::*;
-use crate::grid::lattice_coords;
-use crate::grid::Domain;
+use crate::grid::{lattice_coords, Domain};
 use crate::rng::Lcg;
 use crate::shape::stencils::assert_gradient_matches_differences;
 use crate::shape::{LinearHat, Stencils};
