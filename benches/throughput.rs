@@ -118,7 +118,9 @@ fn target(label: &str, benchmark: &str) -> String {
 /// Wobbes' bar with large strain (Table 2), 160 cells and 12 points per cell, to t = 0.02 s:
 /// a 1D case that the TLS compositions run.
 fn large_strain_bar() -> Params {
-    let bar = benchmarks::info("vibrating_bar").expect("the catalogue has the bar");
+    let bar = benchmarks::CATALOG
+        .find("vibrating_bar")
+        .expect("the catalogue has the bar");
     let mut params = benchmarks::default_params(bar.params);
     for (key, value) in [("E", 4.0e4), ("v0", 0.8), ("dt", 1.0e-5), ("t_end", 0.02)] {
         params.insert(key.into(), ParamValue::Float(value));
@@ -143,7 +145,7 @@ struct Variant {
 /// integrator it does not use by default (the particle update is what they change).
 fn variants(filter: Option<&str>) -> Vec<Variant> {
     let mut variants = Vec::new();
-    for preset in methods::presets() {
+    for preset in methods::PRESETS.entries {
         let skipped = filter.is_some_and(|f| f != preset.name) && preset.name != "mpm";
         // The composed method is whatever parts a run names: no preset to time.
         if skipped || preset.name == methods::COMPOSED {

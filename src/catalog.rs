@@ -1,8 +1,13 @@
-//! A catalogue of named parts (shape functions, transfers, integrators): each entry's name,
-//! value and one-line description, found by name, listed, and named in the error for an
-//! unknown one.
+//! A catalogue of named things (method presets, benchmarks, and the parts a method is made
+//! of): found by name, listed, and named in the error for an unknown one.
 
-/// One entry: what experiment files call it, what it is, and a line that says so.
+/// What a catalogue entry is called in experiment files.
+pub trait Named {
+    fn name(&self) -> &'static str;
+}
+
+/// One entry of a catalogue of parts: what experiment files call it, what it is, and a line
+/// that says so.
 #[derive(Debug)]
 pub struct Entry<T: 'static> {
     pub name: &'static str,
@@ -10,25 +15,34 @@ pub struct Entry<T: 'static> {
     pub description: &'static str,
 }
 
-/// The entries of one kind of part, in the order listings show them.
+impl<T> Named for Entry<T> {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+}
+
+/// The entries of one kind of thing, in the order listings show them.
 #[derive(Debug)]
 pub struct Catalog<T: 'static> {
     /// What an entry is, in the singular ("shape function"), for messages.
     pub kind: &'static str,
-    pub entries: &'static [Entry<T>],
+    pub entries: &'static [T],
 }
 
-impl<T> Catalog<T> {
-    pub fn find(&self, name: &str) -> Option<&'static Entry<T>> {
-        self.entries.iter().find(|e| e.name == name)
+/// A catalogue of parts, each entry a value with its name and description.
+pub type Parts<T> = Catalog<Entry<T>>;
+
+impl<T: Named> Catalog<T> {
+    pub fn find(&self, name: &str) -> Option<&'static T> {
+        self.entries.iter().find(|e| e.name() == name)
     }
 
     pub fn names(&self) -> Vec<&'static str> {
-        self.entries.iter().map(|e| e.name).collect()
+        self.entries.iter().map(|e| e.name()).collect()
     }
 
     /// The entry `name`, or an error that lists the valid names.
-    pub fn get(&self, name: &str) -> Result<&'static Entry<T>, String> {
+    pub fn get(&self, name: &str) -> Result<&'static T, String> {
         self.find(name).ok_or_else(|| {
             format!(
                 "unknown {} '{name}'; valid: {}",
@@ -37,12 +51,11 @@ impl<T> Catalog<T> {
             )
         })
     }
+}
 
+impl<T: PartialEq> Parts<T> {
     /// The name of the first entry whose value is `value`.
-    pub fn name_of(&self, value: &T) -> Option<&'static str>
-    where
-        T: PartialEq,
-    {
+    pub fn name_of(&self, value: &T) -> Option<&'static str> {
         self.entries
             .iter()
             .find(|e| &e.value == value)
@@ -67,7 +80,7 @@ pub const fn names_of<T, const N: usize>(entries: &[Entry<T>]) -> [&'static str;
 mod tests {
     use super::*;
 
-    const DIGITS: Catalog<u8> = Catalog {
+    const DIGITS: Parts<u8> = Catalog {
         kind: "digit",
         entries: &[
             Entry {

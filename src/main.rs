@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 
 use serde_json::{json, Value};
 
-use mpmlab::catalog::Catalog;
+use mpmlab::catalog::Parts;
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
 use mpmlab::output::{remove_dead_temps, write_atomically};
@@ -470,7 +470,7 @@ fn param_json(p: &benchmarks::ParamSpec) -> Value {
     })
 }
 
-fn parts_json<T>(parts: &Catalog<T>) -> Value {
+fn parts_json<T>(parts: &Parts<T>) -> Value {
     parts
         .entries
         .iter()
@@ -480,7 +480,8 @@ fn parts_json<T>(parts: &Catalog<T>) -> Value {
 
 /// Everything `list_methods` prints, for tools.
 fn methods_json() -> Value {
-    let presets: Vec<Value> = methods::presets()
+    let presets: Vec<Value> = methods::PRESETS
+        .entries
         .iter()
         .map(|p| {
             let m = &p.method;
@@ -503,7 +504,7 @@ fn methods_json() -> Value {
             "integrator": parts_json(&integrate::INTEGRATORS),
         },
         "method_params": methods::METHOD_PARAMS.iter().map(param_json).collect::<Vec<_>>(),
-        "reference": reference::methods()
+        "reference": reference::METHODS.entries
             .iter()
             .map(|m| {
                 let mut v = named(m.name, m.source, m.description);
@@ -511,11 +512,11 @@ fn methods_json() -> Value {
                 v
             })
             .collect::<Vec<_>>(),
-        "reconstruction": reconstruction_methods::methods()
+        "reconstruction": reconstruction_methods::METHODS.entries
             .iter()
             .map(|m| named(m.name, m.source, m.description))
             .collect::<Vec<_>>(),
-        "shape_functions": shape_methods::methods()
+        "shape_functions": shape_methods::METHODS.entries
             .iter()
             .map(|m| named(m.name, m.source, m.description))
             .collect::<Vec<_>>(),
@@ -524,12 +525,13 @@ fn methods_json() -> Value {
 
 /// Every benchmark with its kind, dimension and parameters, for tools.
 fn benchmarks_json() -> Value {
-    benchmarks::catalog()
+    benchmarks::CATALOG
+        .entries
         .iter()
         .map(|b| {
             json!({
                 "name": b.name,
-                "kind": benchmarks::kind(b).to_string(),
+                "kind": b.kind.to_string(),
                 "dim": b.dim,
                 "source": b.source,
                 "description": b.description,
@@ -550,7 +552,7 @@ fn list(json: bool, as_json: fn() -> Value, as_text: fn()) -> Result<(), String>
     Ok(())
 }
 
-fn print_parts<T>(parts: &Catalog<T>) {
+fn print_parts<T>(parts: &Parts<T>) {
     println!("{}s:", parts.kind);
     for part in parts.entries {
         println!("  {:<20} {}", part.name, part.description);
@@ -559,7 +561,7 @@ fn print_parts<T>(parts: &Catalog<T>) {
 
 fn list_methods() {
     println!("Simulation methods (benchmarks of kind simulation):");
-    for preset in methods::presets() {
+    for preset in methods::PRESETS.entries {
         println!(
             "{:<15} {}  [{}]",
             preset.name, preset.description, preset.source
@@ -578,7 +580,7 @@ fn list_methods() {
         print_param(p);
     }
     println!("\nReference solvers (simulation benchmarks they name):");
-    for m in reference::methods() {
+    for m in reference::METHODS.entries {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
         println!("{:<15} benchmarks: {}", "", m.benchmarks.join(", "));
     }
@@ -586,19 +588,19 @@ fn list_methods() {
         "\nReconstruction methods (reconstruction benchmarks; the weight of a local fit is a \
          parameter, tls_* serve recon_tls):"
     );
-    for m in reconstruction_methods::methods() {
+    for m in reconstruction_methods::METHODS.entries {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
         println!("{:<15} degree={} fit={}", "", m.degree.value(), m.fit);
     }
     println!("\nGrid bases (shape_functions; gamma and tolerance are parameters of lme):");
-    for m in shape_methods::methods() {
+    for m in shape_methods::METHODS.entries {
         println!("{:<15} {}  [{}]", m.name, m.description, m.source);
     }
 }
 
 fn list_benchmarks() {
-    for b in benchmarks::catalog() {
-        let kind = benchmarks::kind(b);
+    for b in benchmarks::CATALOG.entries {
+        let kind = b.kind;
         // The element-wise benchmark runs in its function's dimension, shape_functions in its
         // `dim`.
         let varies = [

@@ -6,7 +6,7 @@ use std::fmt;
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
 use crate::benchmarks::scattered::MAX_GAUSS_POINTS;
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
-use crate::catalog::Catalog;
+use crate::catalog::{Catalog, Named, Parts};
 use crate::integrate::{IntegratorKind, INTEGRATORS, INTEGRATOR_NAMES};
 use crate::params::{get_f64, get_str, get_usize, ParamError, ParamValue, Params};
 use crate::reconstruct::{
@@ -71,6 +71,12 @@ pub struct MethodPreset {
     pub description: &'static str,
 }
 
+impl Named for MethodPreset {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+}
+
 const fn on_domains(
     shape: DomainShape,
     transfer: TransferKind,
@@ -93,278 +99,277 @@ const fn musl_on(shape: ShapeKind, transfer: TransferKind) -> Method {
     }
 }
 
-const PRESETS: &[MethodPreset] = &[
-    MethodPreset {
-        name: "mpm",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Shepard,
-            integrator: IntegratorKind::Leapfrog,
-            sampled_velocity: SampledVelocity::Stepped,
+pub const PRESETS: Catalog<MethodPreset> = Catalog {
+    kind: "method",
+    entries: &[
+        MethodPreset {
+            name: "mpm",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Shepard,
+                integrator: IntegratorKind::Leapfrog,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Gong 2015, ch. 4",
+            description: "original MPM: linear hat basis, lumped mass, leapfrog",
         },
-        source: "Gong 2015, ch. 4",
-        description: "original MPM: linear hat basis, lumped mass, leapfrog",
-    },
-    MethodPreset {
-        name: "mpm_musl",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Shepard,
-            integrator: IntegratorKind::Musl,
-            sampled_velocity: SampledVelocity::Stepped,
+        MethodPreset {
+            name: "mpm_musl",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Shepard,
+                integrator: IntegratorKind::Musl,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Sulsky et al. 1994; Tran et al. 2019, eqs 31-40 with Shepard mapping",
+            description: "original MPM mapping with the modified update-stress-last step",
         },
-        source: "Sulsky et al. 1994; Tran et al. 2019, eqs 31-40 with Shepard mapping",
-        description: "original MPM mapping with the modified update-stress-last step",
-    },
-    MethodPreset {
-        name: "impm",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Quadrature(IMPM),
-            integrator: IntegratorKind::Leapfrog,
-            sampled_velocity: SampledVelocity::Stepped,
+        MethodPreset {
+            name: "impm",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Quadrature(IMPM),
+                integrator: IntegratorKind::Leapfrog,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Gong 2015, ch. 5",
+            description: "improved MPM: MLS velocity at nodes, MLS density/stress at cell centres",
         },
-        source: "Gong 2015, ch. 5",
-        description: "improved MPM: MLS velocity at nodes, MLS density/stress at cell centres",
-    },
-    MethodPreset {
-        name: "impm_velocity_only",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::FittedVelocity(IMPM_VELOCITY),
-            integrator: IntegratorKind::Leapfrog,
-            sampled_velocity: SampledVelocity::Stepped,
-        },
-        source: "Gong 2015, sec 5.3 (eq 5.6 alone), to isolate IMPM's parts",
-        description: "IMPM's MLS nodal velocity alone: mass and forces lumped at the particles as \
+        MethodPreset {
+            name: "impm_velocity_only",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::FittedVelocity(IMPM_VELOCITY),
+                integrator: IntegratorKind::Leapfrog,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Gong 2015, sec 5.3 (eq 5.6 alone), to isolate IMPM's parts",
+            description:
+                "IMPM's MLS nodal velocity alone: mass and forces lumped at the particles as \
                       in mpm, leapfrog",
-    },
-    MethodPreset {
-        name: "impm_fields_only",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Quadrature(IMPM_FIELDS),
-            integrator: IntegratorKind::Leapfrog,
-            sampled_velocity: SampledVelocity::Stepped,
         },
-        source: "Gong 2015, sec 5.3 (eqs 5.7-5.14 alone), to isolate IMPM's parts",
-        description: "IMPM's MLS density/stress at cell centres alone: the nodal velocity the \
+        MethodPreset {
+            name: "impm_fields_only",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Quadrature(IMPM_FIELDS),
+                integrator: IntegratorKind::Leapfrog,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Gong 2015, sec 5.3 (eqs 5.7-5.14 alone), to isolate IMPM's parts",
+            description: "IMPM's MLS density/stress at cell centres alone: the nodal velocity the \
                       mass-weighted average of mpm, leapfrog",
-    },
-    MethodPreset {
-        name: "imls",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Quadrature(IMLS),
-            integrator: IntegratorKind::Musl,
-            sampled_velocity: SampledVelocity::Stepped,
         },
-        source: "Tran, Berzins, Solowski 2019",
-        description: "IMLS-MPM: IMLS velocity at nodes, IMLS fields at 2 Gauss points, MUSL",
-    },
-    MethodPreset {
-        name: "imls_cpls",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Quadrature(IMLS_CPLS),
-            integrator: IntegratorKind::Usl,
-            sampled_velocity: SampledVelocity::Stepped,
+        MethodPreset {
+            name: "imls",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Quadrature(IMLS),
+                integrator: IntegratorKind::Musl,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Tran, Berzins, Solowski 2019",
+            description: "IMLS-MPM: IMLS velocity at nodes, IMLS fields at 2 Gauss points, MUSL",
         },
-        source: "Tran, Berzins, Solowski 2019, as their CPLS code runs it (IMLS_MPM_solver.m)",
-        description:
-            "IMLS-MPM: IMLS velocity at nodes, IMLS fields and rho b at the cell centre, USL",
-    },
-    MethodPreset {
-        name: "imls_eq27",
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Quadrature(IMLS_EQ27),
-            integrator: IntegratorKind::Musl,
-            sampled_velocity: SampledVelocity::Stepped,
+        MethodPreset {
+            name: "imls_cpls",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Quadrature(IMLS_CPLS),
+                integrator: IntegratorKind::Usl,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Tran, Berzins, Solowski 2019, as their CPLS code runs it (IMLS_MPM_solver.m)",
+            description:
+                "IMLS-MPM: IMLS velocity at nodes, IMLS fields and rho b at the cell centre, USL",
         },
-        source: "Tran, Berzins, Solowski 2019, eq 27 as printed",
-        description: "IMLS-MPM with the field weight scaled by 2h (support 3h)",
-    },
-    MethodPreset {
-        name: "mpm_tls",
-        method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS)),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
-        description: "MPM with the conservative TLS mapping and the consistent mass matrix, MUSL",
-    },
-    MethodPreset {
-        name: "mpm_tls_lumped",
-        method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS_LUMPED)),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
-        description: "MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
-    },
-    MethodPreset {
-        name: "ugimp",
-        method: on_domains(
-            DomainShape::FixedBox,
-            TransferKind::Shepard,
-            IntegratorKind::Leapfrog,
-        ),
-        source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
-        description: "uGIMP: the hat averaged over the initial particle box, leapfrog",
-    },
-    MethodPreset {
-        name: "cpgimp",
-        method: on_domains(
-            DomainShape::StretchedBox,
-            TransferKind::Shepard,
-            IntegratorKind::Leapfrog,
-        ),
-        source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
-        description: "cpGIMP: the particle box stretched by the diagonal of F, leapfrog",
-    },
-    MethodPreset {
-        name: "cpdi1",
-        method: on_domains(
-            DomainShape::Parallelogram,
-            TransferKind::Shepard,
-            IntegratorKind::Leapfrog,
-        ),
-        source: "Sadeghirad et al. 2011; Gong 2015, sec 6.4",
-        description: "CPDI1: parallelogram domains r_k = F r_k^0, leapfrog",
-    },
-    MethodPreset {
-        name: "cpdi1_musl",
-        method: on_domains(
-            DomainShape::Parallelogram,
-            TransferKind::Shepard,
-            IntegratorKind::Musl,
-        ),
-        source: "Sadeghirad et al. 2011 in the scheme of Tran et al. 2019, eqs 31-40",
-        description: "CPDI1 with the modified update-stress-last step",
-    },
-    MethodPreset {
-        name: "cpdi2",
-        method: on_domains(
-            DomainShape::Quadrilateral,
-            TransferKind::Shepard,
-            IntegratorKind::Leapfrog,
-        ),
-        source: "Sadeghirad et al. 2013; Gong 2015, secs 6.5-6.6",
-        description: "CPDI2: domain corners moved with the grid velocity, leapfrog",
-    },
-    MethodPreset {
-        name: "cpdi_mls",
-        method: on_domains(
-            DomainShape::Quadrilateral,
-            TransferKind::FittedVelocity(IMPM_VELOCITY),
-            IntegratorKind::Leapfrog,
-        ),
-        source: "Gong 2015, sec 6.6 (improved CPDI)",
-        description: "CPDI2 with IMPM's MLS velocity at the nodes (cubic spline), leapfrog",
-    },
-    MethodPreset {
-        name: "lme",
-        method: Method {
-            shape: LME_UNSET,
-            transfer: TransferKind::Shepard,
-            integrator: IntegratorKind::PredictorCorrector,
-            sampled_velocity: SampledVelocity::Stepped,
+        MethodPreset {
+            name: "imls_eq27",
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Quadrature(IMLS_EQ27),
+                integrator: IntegratorKind::Musl,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Tran, Berzins, Solowski 2019, eq 27 as printed",
+            description: "IMLS-MPM with the field weight scaled by 2h (support 3h)",
         },
-        source: "Molinos, Navas, Pastor, Stickle, secs 4-5",
-        description: "local max-ent basis (gamma from the run), lumped mass, predictor-corrector",
-    },
-    MethodPreset {
-        name: "bsmpm",
-        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Shepard),
-        source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
-        description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
-    },
-    MethodPreset {
-        name: "bsmpm_consistent",
-        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::ConsistentMass),
-        source: "Wobbes et al. 2018, eq 8 with the consistent mass matrix",
-        description: "B-spline MPM with the consistent mass matrix of the particle quadrature, \
+        MethodPreset {
+            name: "mpm_tls",
+            method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS)),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+            description:
+                "MPM with the conservative TLS mapping and the consistent mass matrix, MUSL",
+        },
+        MethodPreset {
+            name: "mpm_tls_lumped",
+            method: musl_on(ShapeKind::Linear, TransferKind::Taylor(TLS_LUMPED)),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+            description: "MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
+        },
+        MethodPreset {
+            name: "ugimp",
+            method: on_domains(
+                DomainShape::FixedBox,
+                TransferKind::Shepard,
+                IntegratorKind::Leapfrog,
+            ),
+            source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
+            description: "uGIMP: the hat averaged over the initial particle box, leapfrog",
+        },
+        MethodPreset {
+            name: "cpgimp",
+            method: on_domains(
+                DomainShape::StretchedBox,
+                TransferKind::Shepard,
+                IntegratorKind::Leapfrog,
+            ),
+            source: "Bardenhagen & Kober 2004; Gong 2015, sec 6.3",
+            description: "cpGIMP: the particle box stretched by the diagonal of F, leapfrog",
+        },
+        MethodPreset {
+            name: "cpdi1",
+            method: on_domains(
+                DomainShape::Parallelogram,
+                TransferKind::Shepard,
+                IntegratorKind::Leapfrog,
+            ),
+            source: "Sadeghirad et al. 2011; Gong 2015, sec 6.4",
+            description: "CPDI1: parallelogram domains r_k = F r_k^0, leapfrog",
+        },
+        MethodPreset {
+            name: "cpdi1_musl",
+            method: on_domains(
+                DomainShape::Parallelogram,
+                TransferKind::Shepard,
+                IntegratorKind::Musl,
+            ),
+            source: "Sadeghirad et al. 2011 in the scheme of Tran et al. 2019, eqs 31-40",
+            description: "CPDI1 with the modified update-stress-last step",
+        },
+        MethodPreset {
+            name: "cpdi2",
+            method: on_domains(
+                DomainShape::Quadrilateral,
+                TransferKind::Shepard,
+                IntegratorKind::Leapfrog,
+            ),
+            source: "Sadeghirad et al. 2013; Gong 2015, secs 6.5-6.6",
+            description: "CPDI2: domain corners moved with the grid velocity, leapfrog",
+        },
+        MethodPreset {
+            name: "cpdi_mls",
+            method: on_domains(
+                DomainShape::Quadrilateral,
+                TransferKind::FittedVelocity(IMPM_VELOCITY),
+                IntegratorKind::Leapfrog,
+            ),
+            source: "Gong 2015, sec 6.6 (improved CPDI)",
+            description: "CPDI2 with IMPM's MLS velocity at the nodes (cubic spline), leapfrog",
+        },
+        MethodPreset {
+            name: "lme",
+            method: Method {
+                shape: LME_UNSET,
+                transfer: TransferKind::Shepard,
+                integrator: IntegratorKind::PredictorCorrector,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "Molinos, Navas, Pastor, Stickle, secs 4-5",
+            description:
+                "local max-ent basis (gamma from the run), lumped mass, predictor-corrector",
+        },
+        MethodPreset {
+            name: "bsmpm",
+            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Shepard),
+            source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
+            description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
+        },
+        MethodPreset {
+            name: "bsmpm_consistent",
+            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::ConsistentMass),
+            source: "Wobbes et al. 2018, eq 8 with the consistent mass matrix",
+            description:
+                "B-spline MPM with the consistent mass matrix of the particle quadrature, \
                       MUSL",
-    },
-    MethodPreset {
-        name: "ddmpm",
-        method: musl_on(
-            ShapeKind::DualDomain(DualIntegrals::Particles),
-            TransferKind::Shepard,
-        ),
-        source: "Zhang, Ma & Giguere 2011; Wobbes et al. 2018",
-        description: "dual-domain MPM: hat values, gradient averaged by particle sums over each \
+        },
+        MethodPreset {
+            name: "ddmpm",
+            method: musl_on(
+                ShapeKind::DualDomain(DualIntegrals::Particles),
+                TransferKind::Shepard,
+            ),
+            source: "Zhang, Ma & Giguere 2011; Wobbes et al. 2018",
+            description:
+                "dual-domain MPM: hat values, gradient averaged by particle sums over each \
                       node's dual domain, lumped mass, MUSL",
-    },
-    MethodPreset {
-        name: "ddmpm_cells",
-        method: musl_on(
-            ShapeKind::DualDomain(DualIntegrals::ActiveCells),
-            TransferKind::Shepard,
-        ),
-        source: "Zhang, Ma & Giguere 2011, with exact integrals over the cells holding particles",
-        description: "dual-domain MPM with the averages integrated exactly over the active cells, \
-                      lumped mass, MUSL",
-    },
-    MethodPreset {
-        name: "bsmpm_tls",
-        method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Taylor(TLS)),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
-        description: "B-spline MPM with the conservative TLS mapping on each knot span, MUSL",
-    },
-    MethodPreset {
-        name: "bsmpm_tls_lumped",
-        method: musl_on(
-            ShapeKind::QuadraticBSpline,
-            TransferKind::Taylor(TLS_LUMPED),
-        ),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
-        description: "B-spline MPM with the conservative TLS mapping and the lumped mass matrix, \
-                      MUSL",
-    },
-    MethodPreset {
-        name: "ddmpm_tls",
-        method: musl_on(
-            ShapeKind::DualDomain(DualIntegrals::Particles),
-            TransferKind::Taylor(TLS),
-        ),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
-        description: "dual-domain MPM with the conservative TLS mapping, MUSL",
-    },
-    MethodPreset {
-        name: "ddmpm_tls_lumped",
-        method: musl_on(
-            ShapeKind::DualDomain(DualIntegrals::Particles),
-            TransferKind::Taylor(TLS_LUMPED),
-        ),
-        source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
-        description:
-            "dual-domain MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
-    },
-    MethodPreset {
-        name: COMPOSED,
-        method: Method {
-            shape: ShapeKind::Linear,
-            transfer: TransferKind::Shepard,
-            integrator: IntegratorKind::Leapfrog,
-            sampled_velocity: SampledVelocity::Stepped,
         },
-        source: "the run's parts",
-        description: "the composition of the run's shape, transfer and integrator (all three \
+        MethodPreset {
+            name: "ddmpm_cells",
+            method: musl_on(
+                ShapeKind::DualDomain(DualIntegrals::ActiveCells),
+                TransferKind::Shepard,
+            ),
+            source:
+                "Zhang, Ma & Giguere 2011, with exact integrals over the cells holding particles",
+            description:
+                "dual-domain MPM with the averages integrated exactly over the active cells, \
+                      lumped mass, MUSL",
+        },
+        MethodPreset {
+            name: "bsmpm_tls",
+            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Taylor(TLS)),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+            description: "B-spline MPM with the conservative TLS mapping on each knot span, MUSL",
+        },
+        MethodPreset {
+            name: "bsmpm_tls_lumped",
+            method: musl_on(
+                ShapeKind::QuadraticBSpline,
+                TransferKind::Taylor(TLS_LUMPED),
+            ),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+            description:
+                "B-spline MPM with the conservative TLS mapping and the lumped mass matrix, \
+                      MUSL",
+        },
+        MethodPreset {
+            name: "ddmpm_tls",
+            method: musl_on(
+                ShapeKind::DualDomain(DualIntegrals::Particles),
+                TransferKind::Taylor(TLS),
+            ),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
+            description: "dual-domain MPM with the conservative TLS mapping, MUSL",
+        },
+        MethodPreset {
+            name: "ddmpm_tls_lumped",
+            method: musl_on(
+                ShapeKind::DualDomain(DualIntegrals::Particles),
+                TransferKind::Taylor(TLS_LUMPED),
+            ),
+            source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",
+            description:
+                "dual-domain MPM with the conservative TLS mapping and the lumped mass matrix, MUSL",
+        },
+        MethodPreset {
+            name: COMPOSED,
+            method: Method {
+                shape: ShapeKind::Linear,
+                transfer: TransferKind::Shepard,
+                integrator: IntegratorKind::Leapfrog,
+                sampled_velocity: SampledVelocity::Stepped,
+            },
+            source: "the run's parts",
+            description: "the composition of the run's shape, transfer and integrator (all three \
                       required; `mpmlab list-methods` lists each part)",
-    },
-];
+        },
+    ],
+};
 
 /// The preset that is no preset: a method composed of the run's `shape`, `transfer` and
 /// `integrator` alone.
 pub const COMPOSED: &str = "composed";
-
-pub fn presets() -> &'static [MethodPreset] {
-    PRESETS
-}
-
-pub fn preset(name: &str) -> Option<&'static MethodPreset> {
-    PRESETS.iter().find(|p| p.name == name)
-}
-
-pub fn preset_names() -> Vec<&'static str> {
-    PRESETS.iter().map(|p| p.name).collect()
-}
 
 pub const SHAPE_KEY: &str = "shape";
 pub const TRANSFER_KEY: &str = "transfer";
@@ -539,7 +544,7 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
 fn named_part<T: Copy>(
     params: &Params,
     key: &str,
-    parts: &Catalog<T>,
+    parts: &Parts<T>,
 ) -> Result<Option<T>, ParamError> {
     if !params.contains_key(key) {
         return Ok(None);
@@ -554,7 +559,7 @@ fn named_part<T: Copy>(
 pub fn run_shape(method: &str, params: &Params) -> Option<ShapeKind> {
     match params.get(SHAPE_KEY) {
         Some(ParamValue::Str(name)) => SHAPES.find(name).map(|e| e.value),
-        _ => preset(method).map(|p| p.method.shape),
+        _ => PRESETS.find(method).map(|p| p.method.shape),
     }
 }
 
@@ -732,6 +737,7 @@ fn check_lme(lme: &LmeSettings, dim: usize) -> Result<(), ParamError> {
 /// The presets whose composition satisfies `keep`.
 fn preset_names_where(keep: impl Fn(&Method) -> bool) -> Vec<&'static str> {
     PRESETS
+        .entries
         .iter()
         .filter(|p| p.name != COMPOSED && keep(&p.method))
         .map(|p| p.name)
@@ -782,8 +788,8 @@ mod tests {
 
     #[test]
     fn every_preset_is_the_composition_of_its_named_parts() {
-        let composed = preset(COMPOSED).unwrap();
-        for preset in presets().iter().filter(|p| p.name != COMPOSED) {
+        let composed = PRESETS.find(COMPOSED).unwrap();
+        for preset in PRESETS.entries.iter().filter(|p| p.name != COMPOSED) {
             let parts = parts_of(preset);
             let mut own = params(&[]);
             own.extend(
@@ -804,7 +810,7 @@ mod tests {
 
     #[test]
     fn a_part_given_beside_a_preset_replaces_the_presets() {
-        let mpm = preset("mpm").unwrap();
+        let mpm = PRESETS.find("mpm").unwrap();
         let method = resolve(mpm, &params(&[(TRANSFER_KEY, text("mls_velocity"))]), 1).unwrap();
         assert_eq!(method.transfer, TransferKind::FittedVelocity(IMPM_VELOCITY));
         assert_eq!(
@@ -817,7 +823,7 @@ mod tests {
 
     #[test]
     fn parts_that_cannot_run_together_are_refused_with_the_reason() {
-        let imls = preset("imls").unwrap();
+        let imls = PRESETS.find("imls").unwrap();
         let e = resolve(imls, &params(&[(SHAPE_KEY, text("quadratic_bspline"))]), 1).unwrap_err();
         assert_eq!(e.key, SHAPE_KEY);
         assert!(
@@ -827,7 +833,7 @@ mod tests {
             "{}",
             e.message
         );
-        let composed = preset(COMPOSED).unwrap();
+        let composed = PRESETS.find(COMPOSED).unwrap();
         let tls_leapfrog = params(&[
             (SHAPE_KEY, text("linear")),
             (TRANSFER_KEY, text("tls")),

@@ -6,6 +6,7 @@
 
 use std::fmt;
 
+use crate::catalog::{Catalog, Named};
 use crate::reconstruct::{Conservation, Degree, Solver};
 
 pub struct ReconstructionMethod {
@@ -14,6 +15,12 @@ pub struct ReconstructionMethod {
     pub fit: Fit,
     pub source: &'static str,
     pub description: &'static str,
+}
+
+impl Named for ReconstructionMethod {
+    fn name(&self) -> &'static str {
+        self.name
+    }
 }
 
 /// Where a method fits and how it solves.
@@ -41,71 +48,62 @@ impl ReconstructionMethod {
     }
 }
 
-const METHODS: &[ReconstructionMethod] = &[
-    ReconstructionMethod {
-        name: "shepard",
-        degree: Degree::CONSTANT,
-        // With one basis function both solvers divide by the sum of the weights.
-        fit: Fit::Local(Solver::Mls),
-        source: "Gong 2015, eqs 4.6-4.8",
-        description:
-            "Shepard interpolation (first-order MLS): weighted average, reproduces constants",
-    },
-    ReconstructionMethod {
-        name: "mls_linear",
-        degree: Degree::LINEAR,
-        fit: Fit::Local(Solver::Mls),
-        source: "Gong 2015, sec 3.5 and 5.2",
-        description: "second-order MLS: linear basis, moment matrix inverted",
-    },
-    ReconstructionMethod {
-        name: "mls_quadratic",
-        degree: Degree::QUADRATIC,
-        fit: Fit::Local(Solver::Mls),
-        source: "Gong 2015, sec 3.4",
-        description: "MLS with a quadratic basis, moment matrix inverted",
-    },
-    ReconstructionMethod {
-        name: "imls_linear",
-        degree: Degree::LINEAR,
-        fit: Fit::Local(Solver::Imls),
-        source: "Tran et al. 2019, eqs 11-17",
-        description:
-            "IMLS: linear basis orthogonalised, polynomials the data cannot support dropped",
-    },
-    ReconstructionMethod {
-        name: "imls_quadratic",
-        degree: Degree::QUADRATIC,
-        fit: Fit::Local(Solver::Imls),
-        source: "Tran et al. 2019, eqs 11-17",
-        description:
-            "IMLS: quadratic basis orthogonalised, polynomials the data cannot support dropped",
-    },
-    ReconstructionMethod {
-        name: "tls_fixed",
-        degree: Degree::QUADRATIC,
-        fit: Fit::Taylor(Conservation::Fixed),
-        source: "Wobbes et al. 2018, sec 2, eq 5",
-        description: "Taylor least squares per element, quadratic; a_1 = the element mean, \
+pub const METHODS: Catalog<ReconstructionMethod> = Catalog {
+    kind: "reconstruction method",
+    entries: &[
+        ReconstructionMethod {
+            name: "shepard",
+            degree: Degree::CONSTANT,
+            // With one basis function both solvers divide by the sum of the weights.
+            fit: Fit::Local(Solver::Mls),
+            source: "Gong 2015, eqs 4.6-4.8",
+            description:
+                "Shepard interpolation (first-order MLS): weighted average, reproduces constants",
+        },
+        ReconstructionMethod {
+            name: "mls_linear",
+            degree: Degree::LINEAR,
+            fit: Fit::Local(Solver::Mls),
+            source: "Gong 2015, sec 3.5 and 5.2",
+            description: "second-order MLS: linear basis, moment matrix inverted",
+        },
+        ReconstructionMethod {
+            name: "mls_quadratic",
+            degree: Degree::QUADRATIC,
+            fit: Fit::Local(Solver::Mls),
+            source: "Gong 2015, sec 3.4",
+            description: "MLS with a quadratic basis, moment matrix inverted",
+        },
+        ReconstructionMethod {
+            name: "imls_linear",
+            degree: Degree::LINEAR,
+            fit: Fit::Local(Solver::Imls),
+            source: "Tran et al. 2019, eqs 11-17",
+            description:
+                "IMLS: linear basis orthogonalised, polynomials the data cannot support dropped",
+        },
+        ReconstructionMethod {
+            name: "imls_quadratic",
+            degree: Degree::QUADRATIC,
+            fit: Fit::Local(Solver::Imls),
+            source: "Tran et al. 2019, eqs 11-17",
+            description:
+                "IMLS: quadratic basis orthogonalised, polynomials the data cannot support dropped",
+        },
+        ReconstructionMethod {
+            name: "tls_fixed",
+            degree: Degree::QUADRATIC,
+            fit: Fit::Taylor(Conservation::Fixed),
+            source: "Wobbes et al. 2018, sec 2, eq 5",
+            description: "Taylor least squares per element, quadratic; a_1 = the element mean, \
                       which conserves the element integral",
-    },
-    ReconstructionMethod {
-        name: "tls_fitted",
-        degree: Degree::QUADRATIC,
-        fit: Fit::Taylor(Conservation::Fitted),
-        source: "Wobbes et al. 2018, sec 2, eq 1",
-        description: "Taylor least squares per element, quadratic; every coefficient fitted",
-    },
-];
-
-pub fn methods() -> &'static [ReconstructionMethod] {
-    METHODS
-}
-
-pub fn method(name: &str) -> Option<&'static ReconstructionMethod> {
-    METHODS.iter().find(|m| m.name == name)
-}
-
-pub fn method_names() -> Vec<&'static str> {
-    METHODS.iter().map(|m| m.name).collect()
-}
+        },
+        ReconstructionMethod {
+            name: "tls_fitted",
+            degree: Degree::QUADRATIC,
+            fit: Fit::Taylor(Conservation::Fitted),
+            source: "Wobbes et al. 2018, sec 2, eq 1",
+            description: "Taylor least squares per element, quadratic; every coefficient fitted",
+        },
+    ],
+};

@@ -228,7 +228,9 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
 /// by this, across experiments, so it is computed from the validated parameters alone and is
 /// the same on every machine.
 pub fn estimated_cost(run: &RunSpec) -> u64 {
-    let dim = crate::benchmarks::info(&run.benchmark).map_or(1, |b| b.dim) as u32;
+    let dim = crate::benchmarks::CATALOG
+        .find(&run.benchmark)
+        .map_or(1, |b| b.dim) as u32;
     let cells = get_usize(&run.params, "cells").unwrap_or(1) as u64;
     let ppc = get_usize(&run.params, "ppc").unwrap_or(1) as u64;
     let particles = cells.saturating_mul(ppc).saturating_pow(dim);

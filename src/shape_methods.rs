@@ -2,6 +2,7 @@
 //! of Molinos et al. and, for comparison, the hat it tends to for large gamma and the quadratic
 //! B-spline.
 
+use crate::catalog::{Catalog, Named};
 use std::fmt;
 
 /// Which basis a method evaluates.
@@ -32,35 +33,32 @@ pub struct ShapeMethod {
     pub description: &'static str,
 }
 
-const METHODS: &[ShapeMethod] = &[
-    ShapeMethod {
-        name: "lme",
-        basis: Basis::Lme,
-        source: "Molinos et al., sec 5, eqs 32-38",
-        description: "local maximum-entropy basis, locality gamma and cut-off tolerance",
-    },
-    ShapeMethod {
-        name: "linear",
-        basis: Basis::Linear,
-        source: "Gong 2015, eq 4.8",
-        description: "piecewise-linear hat (tensor product in 2D)",
-    },
-    ShapeMethod {
-        name: "quadratic_bspline",
-        basis: Basis::QuadraticBSpline,
-        source: "Steffen et al. 2008; Wobbes et al. 2018",
-        description: "quadratic B-spline on the open knot vector",
-    },
-];
-
-pub fn methods() -> &'static [ShapeMethod] {
-    METHODS
+impl Named for ShapeMethod {
+    fn name(&self) -> &'static str {
+        self.name
+    }
 }
 
-pub fn method(name: &str) -> Option<&'static ShapeMethod> {
-    METHODS.iter().find(|m| m.name == name)
-}
-
-pub fn method_names() -> Vec<&'static str> {
-    METHODS.iter().map(|m| m.name).collect()
-}
+pub const METHODS: Catalog<ShapeMethod> = Catalog {
+    kind: "grid basis",
+    entries: &[
+        ShapeMethod {
+            name: "lme",
+            basis: Basis::Lme,
+            source: "Molinos et al., sec 5, eqs 32-38",
+            description: "local maximum-entropy basis, locality gamma and cut-off tolerance",
+        },
+        ShapeMethod {
+            name: "linear",
+            basis: Basis::Linear,
+            source: "Gong 2015, eq 4.8",
+            description: "piecewise-linear hat (tensor product in 2D)",
+        },
+        ShapeMethod {
+            name: "quadratic_bspline",
+            basis: Basis::QuadraticBSpline,
+            source: "Steffen et al. 2008; Wobbes et al. 2018",
+            description: "quadratic B-spline on the open knot vector",
+        },
+    ],
+};

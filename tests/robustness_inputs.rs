@@ -127,7 +127,7 @@ fn runs_take_the_time_step_their_check_approves() {
     let mut compared = 0;
     for entry in std::fs::read_dir("experiments").unwrap() {
         let experiment = experiment::load(&entry.unwrap().path()).unwrap();
-        let info = benchmarks::info(&experiment.benchmark).unwrap();
+        let info = benchmarks::CATALOG.find(&experiment.benchmark).unwrap();
         let Some(time_step) = info.time_step else {
             continue;
         };

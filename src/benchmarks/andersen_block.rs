@@ -14,6 +14,7 @@ use std::f64::consts::PI;
 use nalgebra::{SMatrix, SVector, Vector2};
 
 use super::limits::{check_lattice, courant_time_step};
+use super::BenchmarkKind;
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
@@ -108,6 +109,7 @@ const PARAMS: &[ParamSpec] = &[
 
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "andersen_block",
+    kind: BenchmarkKind::Simulation,
     dim: 2,
     source: "Molinos et al., sec 6.2, eq 41 (Andersen 2009)",
     description: "elastic block on a rigid base under gravity ramped up by eq 41; probes \
@@ -286,7 +288,7 @@ mod tests {
     fn cell(b: &AndersenBlock) -> f64 {
         b.height / b.cells as f64
     }
-    use crate::benchmarks::{catalog, default_params};
+    use crate::benchmarks::{default_params, CATALOG};
     use crate::grid::Grid;
     use crate::params::ParamValue;
 
@@ -300,7 +302,7 @@ mod tests {
 
     #[test]
     fn is_in_the_catalogue_with_the_papers_grid() {
-        assert!(catalog().iter().any(|b| b.name == "andersen_block"));
+        assert!(CATALOG.entries.iter().any(|b| b.name == "andersen_block"));
         let b = block(&[]);
         assert_eq!(cell(&b), 2.0);
         let domain = b.domain();

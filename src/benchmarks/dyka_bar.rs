@@ -11,6 +11,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::limits::{check_lattice, courant_time_step};
+use super::BenchmarkKind;
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
@@ -85,6 +86,7 @@ const PARAMS: &[ParamSpec] = &[
 
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "dyka_bar",
+    kind: BenchmarkKind::Simulation,
     dim: 1,
     source: "Molinos et al., sec 6.1, appendix A (Dyka & Ingel 1995)",
     description: "linear-elastic bar, x = 0 fixed, x = L free, v0 on the last quarter; probes \
@@ -298,7 +300,7 @@ mod tests {
     fn cell(bar: &DykaBar) -> f64 {
         bar.length / bar.cells as f64
     }
-    use crate::benchmarks::{catalog, default_params};
+    use crate::benchmarks::{default_params, CATALOG};
     use crate::params::ParamValue;
 
     fn bar(overrides: &[(&str, ParamValue)]) -> DykaBar {
@@ -315,7 +317,7 @@ mod tests {
 
     #[test]
     fn is_in_the_catalogue_with_the_papers_grid_and_steps() {
-        assert!(catalog().iter().any(|b| b.name == "dyka_bar"));
+        assert!(CATALOG.entries.iter().any(|b| b.name == "dyka_bar"));
         let bar = bar(&[]);
         assert!((cell(&bar) - 3.3325e-3).abs() < 1e-15);
         // c = sqrt(200e9 / 7833) = 5053.02 m/s, so dt = 0.5 h / c = 3.2975e-7 s and

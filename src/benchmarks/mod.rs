@@ -15,6 +15,7 @@ mod vibrating_bar;
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::catalog::{Catalog, Named};
 use crate::grid::{Domain, Grid};
 use crate::material::Material;
 use crate::params::{ParamError, ParamValue, Params};
@@ -75,6 +76,8 @@ pub fn default_params(specs: &[ParamSpec]) -> Params {
 /// Catalogue entry of a benchmark: what `list-benchmarks` prints and what validation uses.
 pub struct BenchmarkInfo {
     pub name: &'static str,
+    /// What its runs do, which decides what they record.
+    pub kind: BenchmarkKind,
     /// The spatial dimension; for `recon_tls`, whose runs take their function's, the largest.
     pub dim: usize,
     pub source: &'static str,
@@ -91,18 +94,21 @@ pub struct BenchmarkInfo {
 /// How a simulation benchmark's runs step (`BenchmarkInfo::time_step`).
 pub type TimeStepFn = fn(&Params) -> Result<TimeStep, ParamError>;
 
-const CATALOG: &[BenchmarkInfo] = &[
-    mms_gong::INFO_1D,
-    mms_gong::INFO_2D,
-    mms_tran::INFO,
-    vibrating_bar::INFO,
-    dyka_bar::INFO,
-    andersen_block::INFO,
-    scattered::INFO_NODES,
-    scattered::INFO_BASIS,
-    scattered::INFO_ELEMENTS,
-    shape_functions::INFO,
-];
+pub const CATALOG: Catalog<BenchmarkInfo> = Catalog {
+    kind: "benchmark",
+    entries: &[
+        mms_gong::INFO_1D,
+        mms_gong::INFO_2D,
+        mms_tran::INFO,
+        vibrating_bar::INFO,
+        dyka_bar::INFO,
+        andersen_block::INFO,
+        scattered::INFO_NODES,
+        scattered::INFO_BASIS,
+        scattered::INFO_ELEMENTS,
+        shape_functions::INFO,
+    ],
+};
 
 /// What a run of a benchmark computes, and so which methods, measures and figures apply.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -150,14 +156,6 @@ impl std::fmt::Display for BenchmarkKind {
     }
 }
 
-/// The kind of a catalogue entry: the reconstruction benchmarks and `shape_functions` say
-/// which they are, every other benchmark is a simulation.
-pub fn kind(info: &BenchmarkInfo) -> BenchmarkKind {
-    scattered::kind(info.name)
-        .or_else(|| shape_functions::kind(info.name))
-        .unwrap_or(BenchmarkKind::Simulation)
-}
-
 /// The benchmarks whose `Problem::material_point` inverts the exact motion, so that their
 /// runs also measure the grid velocity against the exact one: the manufactured solutions.
 const EXACT_ON_GRID: [&str; 3] = [
@@ -171,16 +169,10 @@ pub fn exact_on_grid(info: &BenchmarkInfo) -> bool {
     EXACT_ON_GRID.contains(&info.name)
 }
 
-pub fn catalog() -> &'static [BenchmarkInfo] {
-    CATALOG
-}
-
-pub fn info(name: &str) -> Option<&'static BenchmarkInfo> {
-    CATALOG.iter().find(|b| b.name == name)
-}
-
-pub fn names() -> Vec<&'static str> {
-    CATALOG.iter().map(|b| b.name).collect()
+impl Named for BenchmarkInfo {
+    fn name(&self) -> &'static str {
+        self.name
+    }
 }
 
 /// Exact state of the material point that started at `X`, in the current configuration.
@@ -348,7 +340,10 @@ pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
         )?))),
         other => Err(ParamError::new(
             "benchmark",
-            format!("unknown benchmark '{other}'; valid: {}", names().join(", ")),
+            format!(
+                "unknown benchmark '{other}'; valid: {}",
+                CATALOG.names().join(", ")
+            ),
         )),
     }
 }
@@ -377,9 +372,10 @@ mod tests {
     #[test]
     fn exact_on_grid_lists_the_problems_that_invert_their_motion() {
         let mut listed = 0;
-        for info in catalog()
+        for info in CATALOG
+            .entries
             .iter()
-            .filter(|i| kind(i) == BenchmarkKind::Simulation)
+            .filter(|i| i.kind == BenchmarkKind::Simulation)
         {
             let params = runnable_params(info);
             let problem =

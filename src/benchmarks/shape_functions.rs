@@ -50,6 +50,7 @@ const PARAMS: &[ParamSpec] = &[
 
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "shape_functions",
+    kind: BenchmarkKind::ShapeFunctions,
     // Runs take the dimension of their `dim`; this is the largest.
     dim: 2,
     source: "Molinos et al., sec 5, Fig 3",
@@ -59,10 +60,6 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     check,
     time_step: None,
 };
-
-pub(super) fn kind(name: &str) -> Option<BenchmarkKind> {
-    (name == INFO.name).then_some(BenchmarkKind::ShapeFunctions)
-}
 
 /// One evaluation problem, resolved from validated parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]

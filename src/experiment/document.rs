@@ -108,9 +108,13 @@ pub(crate) struct Benchmark {
 
 pub(crate) fn benchmark(sections: &Sections) -> Result<Benchmark, ConfigError> {
     let node = sections.require("benchmark")?.value;
-    let info = pick(node, "benchmark", "benchmark", benchmarks::catalog(), |b| {
-        b.name
-    })?;
+    let info = pick(
+        node,
+        "benchmark",
+        "benchmark",
+        benchmarks::CATALOG.entries,
+        |b| b.name,
+    )?;
     Ok(Benchmark {
         info,
         pos: node.pos,

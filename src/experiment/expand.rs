@@ -165,7 +165,7 @@ fn resolve(
     }
     if let Some(reason) = reference::unsupported(&method, benchmark.info.name) {
         let error = ParamError::new(METHOD_KEY, reason);
-        let valid = method_names(benchmarks::kind(benchmark.info))
+        let valid = method_names(benchmark.info.kind)
             .into_iter()
             .filter(|m| reference::unsupported(m, benchmark.info.name).is_none());
         return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
@@ -174,7 +174,7 @@ fn resolve(
         return Err(check_error(error, benchmark, &params, chosen));
     }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
-    if benchmarks::kind(benchmark.info).steps() {
+    if benchmark.info.kind.steps() {
         check_method_params(&method, benchmark, &params)
             .map_err(|e| check_error(e, benchmark, &params, chosen))?;
     }
@@ -203,14 +203,14 @@ fn check_method_params(
     benchmark: &Benchmark,
     params: &Params,
 ) -> Result<(), ParamError> {
-    if let Some(preset) = methods::preset(method) {
+    if let Some(preset) = methods::PRESETS.find(method) {
         return methods::resolve(preset, params, benchmark.info.dim).map(drop);
     }
     match methods::METHOD_PARAMS
         .iter()
         .find(|spec| params.contains_key(spec.key))
     {
-        Some(spec) if reference::method(method).is_some() => Err(ParamError::new(
+        Some(spec) if reference::METHODS.find(method).is_some() => Err(ParamError::new(
             spec.key,
             format!(
                 "{} applies to MPM methods, not to the reference solver {method}",
@@ -319,7 +319,7 @@ fn check_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{BenchmarkInfo, ParamDefault, ParamKind, ParamSpec};
+    use crate::benchmarks::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
     use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
     use crate::params::ParamValue;
@@ -340,6 +340,7 @@ mod tests {
     /// A benchmark whose check rejects its own default, which no real benchmark does.
     const TOY: BenchmarkInfo = BenchmarkInfo {
         name: "toy",
+        kind: BenchmarkKind::Simulation,
         dim: 1,
         source: "",
         description: "",

@@ -59,7 +59,7 @@ fn build(text: &str, path: &Path) -> Result<Experiment, ConfigError> {
     let name = document::name(&sections)?;
     let description = document::description(&sections)?;
     let benchmark = document::benchmark(&sections)?;
-    let kind = benchmarks::kind(benchmark.info);
+    let kind = benchmark.info.kind;
     let space = ParamSpace::read(&sections, benchmark.info)?;
     let (output, every_pos) = document::output(&sections)?;
     let reference = reference::read(sections.get("reference"), &space, benchmark.info, kind)?;
@@ -124,7 +124,8 @@ impl Experiment {
     /// (`Measures::of_benchmark`), and the relative error against the reference run when it
     /// names one.
     pub fn measures(&self) -> Measures {
-        benchmarks::info(&self.benchmark)
+        benchmarks::CATALOG
+            .find(&self.benchmark)
             .map_or(Measures::of(self.kind), Measures::of_benchmark)
             .with_reference(self.reference.is_some())
     }

@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use crate::benchmarks::{self, BenchmarkInfo, ParamDefault};
+use crate::benchmarks::{BenchmarkInfo, ParamDefault};
 use crate::methods::{self, INTEGRATOR_KEY, SHAPE_KEY, TRANSFER_KEY};
 use crate::params::ParamValue;
 
@@ -116,12 +116,12 @@ impl ParamSpace {
             )
         };
         // A simulation that names all three parts of its method needs no preset.
-        let composed = benchmarks::kind(info).steps()
+        let composed = info.kind.steps()
             && [SHAPE_KEY, TRANSFER_KEY, INTEGRATOR_KEY]
                 .iter()
                 .all(|key| self.is_given(key));
         if !self.is_given(METHOD_KEY) && !composed {
-            let valid = method_names(benchmarks::kind(info));
+            let valid = method_names(info.kind);
             return Err(missing(METHOD_KEY).with_valid(valid));
         }
         match info
@@ -202,7 +202,7 @@ fn read_matrix(
     for (i, item) in items.iter().enumerate() {
         let mut block = read_block(item, &item_field("matrix", i), info, fixed)?;
         if let Some(first) = blocks.first() {
-            let composable = benchmarks::kind(info).steps();
+            let composable = info.kind.steps();
             align(&mut block, first, &item_field("matrix", i), composable)?;
         }
         blocks.push(block);

@@ -28,15 +28,16 @@ pub(crate) enum ValueKind {
 /// other reconstruction benchmarks, the grid bases for shape-function evaluation.
 pub(crate) fn method_names(kind: BenchmarkKind) -> Vec<&'static str> {
     if kind.steps() {
-        let mut names = methods::preset_names();
-        names.extend(reference::names());
+        let mut names = methods::PRESETS.names();
+        names.extend(reference::METHODS.names());
         return names;
     }
     if kind == BenchmarkKind::ShapeFunctions {
-        return shape_methods::method_names();
+        return shape_methods::METHODS.names();
     }
     let elementwise = kind == BenchmarkKind::Elementwise;
-    reconstruction_methods::methods()
+    reconstruction_methods::METHODS
+        .entries
         .iter()
         .filter(|m| m.is_elementwise() == elementwise)
         .map(|m| m.name)
@@ -51,9 +52,9 @@ pub(crate) fn settable_kind(
     parent: &str,
 ) -> Result<ValueKind, ConfigError> {
     if entry.key == METHOD_KEY {
-        return Ok(ValueKind::Method(benchmarks::kind(info)));
+        return Ok(ValueKind::Method(info.kind));
     }
-    let (method_params, limits) = if benchmarks::kind(info).steps() {
+    let (method_params, limits) = if info.kind.steps() {
         (methods::METHOD_PARAMS, benchmarks::LIMIT_PARAMS)
     } else {
         (&[][..], &[][..])

@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::catalog::{names_of, Catalog, Entry};
+use crate::catalog::{names_of, Catalog, Entry, Parts};
 
 /// How the grid equations are advanced in time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,7 +92,7 @@ const ENTRIES: &[Entry<IntegratorKind>] = &[
     },
 ];
 
-pub const INTEGRATORS: Catalog<IntegratorKind> = Catalog {
+pub const INTEGRATORS: Parts<IntegratorKind> = Catalog {
     kind: "integrator",
     entries: ENTRIES,
 };

@@ -119,7 +119,7 @@ impl Measures {
     /// The measures of a benchmark's runs: its kind's, with the grid velocity for simulations
     /// that know the exact velocity on the grid.
     pub fn of_benchmark(info: &BenchmarkInfo) -> Measures {
-        let measures = Measures::of(benchmarks::kind(info));
+        let measures = Measures::of(info.kind);
         if measures.fields == ERROR_FIELDS && benchmarks::exact_on_grid(info) {
             Measures {
                 fields: &ERROR_FIELDS_WITH_GRID,

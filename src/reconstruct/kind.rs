@@ -8,7 +8,7 @@ use super::{
     BodyForceFit, Degree, Kernel, MassMatrix, NodalVelocity, QuadratureRecipe, Recipe, Solver,
     TaylorRecipe, Weight,
 };
-use crate::catalog::{names_of, Catalog, Entry};
+use crate::catalog::{names_of, Catalog, Entry, Parts};
 
 /// How particle data reaches the grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,7 +162,7 @@ const ENTRIES: &[Entry<TransferKind>] = &[
     },
 ];
 
-pub const TRANSFERS: Catalog<TransferKind> = Catalog {
+pub const TRANSFERS: Parts<TransferKind> = Catalog {
     kind: "transfer",
     entries: ENTRIES,
 };

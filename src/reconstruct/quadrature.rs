@@ -278,7 +278,8 @@ mod tests {
     use crate::reconstruct::particles_to_grid;
 
     fn recipes() -> Vec<QuadratureRecipe> {
-        methods::presets()
+        methods::PRESETS
+            .entries
             .iter()
             .filter_map(|p| match p.method.transfer {
                 crate::reconstruct::TransferKind::Quadrature(r) => Some(r),
@@ -340,7 +341,7 @@ mod tests {
     }
 
     fn preset_recipe(name: &str) -> QuadratureRecipe {
-        match methods::preset(name).unwrap().method.transfer {
+        match methods::PRESETS.find(name).unwrap().method.transfer {
             crate::reconstruct::TransferKind::Quadrature(r) => r,
             other => panic!("{name} maps with {other}"),
         }

@@ -6,6 +6,8 @@ mod ulfem;
 
 pub use ulfem::UlFem;
 
+use crate::catalog::{Catalog, Named};
+
 /// Catalogue entry of a reference method.
 pub struct ReferenceMethod {
     pub name: &'static str,
@@ -15,29 +17,26 @@ pub struct ReferenceMethod {
     pub description: &'static str,
 }
 
-const METHODS: &[ReferenceMethod] = &[ReferenceMethod {
-    name: "ulfem",
-    benchmarks: &["vibrating_bar"],
-    source: "Wobbes et al. 2018, sec 5 (ULFEM reference)",
-    description: "updated-Lagrangian FEM: 2-node elements, lumped mass, one Gauss point, \
-                  central differences",
-}];
-
-pub fn methods() -> &'static [ReferenceMethod] {
-    METHODS
+impl Named for ReferenceMethod {
+    fn name(&self) -> &'static str {
+        self.name
+    }
 }
 
-pub fn method(name: &str) -> Option<&'static ReferenceMethod> {
-    METHODS.iter().find(|m| m.name == name)
-}
-
-pub fn names() -> Vec<&'static str> {
-    METHODS.iter().map(|m| m.name).collect()
-}
+pub const METHODS: Catalog<ReferenceMethod> = Catalog {
+    kind: "reference solver",
+    entries: &[ReferenceMethod {
+        name: "ulfem",
+        benchmarks: &["vibrating_bar"],
+        source: "Wobbes et al. 2018, sec 5 (ULFEM reference)",
+        description: "updated-Lagrangian FEM: 2-node elements, lumped mass, one Gauss point, \
+                      central differences",
+    }],
+};
 
 /// Why `method` cannot run on `benchmark`, if it is a reference method that does not solve it.
 pub fn unsupported(method: &str, benchmark: &str) -> Option<String> {
-    let m = self::method(method)?;
+    let m = METHODS.find(method)?;
     (!m.benchmarks.contains(&benchmark)).then(|| {
         format!(
             "method '{method}' is a reference solver for {} only, not {benchmark}",

@@ -4,7 +4,7 @@
 use std::fmt;
 
 use super::{DomainShape, DualIntegrals, DEFAULT_TOLERANCE};
-use crate::catalog::{names_of, Catalog, Entry};
+use crate::catalog::{names_of, Catalog, Entry, Parts};
 
 /// Basis functions used on the background grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,7 +105,7 @@ const ENTRIES: &[Entry<ShapeKind>] = &[
     },
 ];
 
-pub const SHAPES: Catalog<ShapeKind> = Catalog {
+pub const SHAPES: Parts<ShapeKind> = Catalog {
     kind: "shape function",
     entries: ENTRIES,
 };

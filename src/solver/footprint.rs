@@ -26,15 +26,16 @@ const UNSTEPPED_BYTES_PER_POINT: f64 = 512.0;
 
 /// The estimated peak memory of `spec` in bytes.
 pub fn estimated_bytes(spec: &RunSpec) -> f64 {
-    let info = benchmarks::info(&spec.benchmark);
+    let info = benchmarks::CATALOG.find(&spec.benchmark);
     let dim = info.map_or(1, |b| b.dim) as i32;
     let int = |key: &str| get_usize(&spec.params, key).unwrap_or(1) as f64;
-    let unstepped = info.is_none_or(|b| benchmarks::kind(b) != BenchmarkKind::Simulation);
+    let unstepped = info.is_none_or(|b| b.kind != BenchmarkKind::Simulation);
     let body_particles = (int("cells") * int("ppc")).powi(dim);
-    if unstepped || crate::reference::method(&spec.method).is_some() {
+    if unstepped || crate::reference::METHODS.find(&spec.method).is_some() {
         return FIXED_BYTES + body_particles * UNSTEPPED_BYTES_PER_POINT;
     }
-    let method = methods::preset(&spec.method)
+    let method = methods::PRESETS
+        .find(&spec.method)
         .and_then(|preset| methods::resolve(preset, &spec.params, dim as usize).ok());
     let (Some(method), Ok(problem)) = (method, benchmarks::build(&spec.benchmark, &spec.params))
     else {

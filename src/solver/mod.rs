@@ -49,12 +49,12 @@ pub fn simulate_into(spec: &RunSpec, file: &hdf5::File) -> RunRecord {
 
 fn simulate_with(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
     let started = Instant::now();
-    let kind = benchmarks::info(&spec.benchmark).map(benchmarks::kind);
+    let kind = benchmarks::CATALOG.find(&spec.benchmark).map(|b| b.kind);
     let mut record = if kind.is_some_and(BenchmarkKind::is_reconstruction) {
         reconstruction::evaluate(spec)
     } else if kind == Some(BenchmarkKind::ShapeFunctions) {
         shape_functions::evaluate(spec)
-    } else if crate::reference::method(&spec.method).is_some() {
+    } else if crate::reference::METHODS.find(&spec.method).is_some() {
         reference::solve(spec, file)
     } else {
         step(spec, file)
@@ -73,13 +73,7 @@ fn step(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
 }
 
 fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
-    let preset = methods::preset(&spec.method).ok_or_else(|| {
-        format!(
-            "unknown method '{}'; valid: {}",
-            spec.method,
-            methods::preset_names().join(", ")
-        )
-    })?;
+    let preset = methods::PRESETS.get(&spec.method)?;
     let problem = benchmarks::build(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
     let dim = match problem {
         AnyProblem::D1(_) => 1,
@@ -608,10 +602,13 @@ pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
     let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
     RunRecord {
         spec: spec.clone(),
-        parts: methods::preset(&spec.method)
-            .map_or(methods::presets()[0].method, |p| p.method)
+        parts: methods::PRESETS
+            .find(&spec.method)
+            .map_or(methods::PRESETS.entries[0].method, |p| p.method)
             .into(),
-        dim: benchmarks::info(&spec.benchmark).map_or(0, |b| b.dim),
+        dim: benchmarks::CATALOG
+            .find(&spec.benchmark)
+            .map_or(0, |b| b.dim),
         cells: int("cells"),
         ppc: int("ppc"),
         h: f64::NAN,

@@ -462,7 +462,7 @@ mod tests {
     }
 
     fn vibrating_bar_params() -> crate::params::Params {
-        let info = crate::benchmarks::info("vibrating_bar").unwrap();
+        let info = crate::benchmarks::CATALOG.find("vibrating_bar").unwrap();
         let mut params = crate::benchmarks::default_params(info.params);
         params.insert("cells".into(), crate::params::ParamValue::Int(4));
         params

@@ -57,11 +57,11 @@ pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
 }
 
 fn prepare(spec: &RunSpec) -> Result<(Basis, ShapeProblem), String> {
-    let method = shape_methods::method(&spec.method).ok_or_else(|| {
+    let method = shape_methods::METHODS.find(&spec.method).ok_or_else(|| {
         format!(
             "unknown basis '{}'; valid: {}",
             spec.method,
-            shape_methods::method_names().join(", ")
+            shape_methods::METHODS.names().join(", ")
         )
     })?;
     let problem = ShapeProblem::from_params(&spec.params).map_err(|e| e.to_string())?;

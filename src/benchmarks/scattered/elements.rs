@@ -6,6 +6,7 @@ use nalgebra::SVector;
 
 use super::functions::{ElementFunction, SurfaceFunction, TestFunction};
 use super::points::{cell_fractions, check_ppc, Spacing};
+use super::BenchmarkKind;
 use super::ParamSpec;
 use super::{choice, interval, BenchmarkInfo, Domain, ParamDefault, ParamKind};
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
@@ -78,6 +79,7 @@ const PARAMS: &[ParamSpec] = &[
 
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "recon_tls",
+    kind: BenchmarkKind::Elementwise,
     // Runs take the dimension of their function; this is the largest.
     dim: 2,
     source: "Wobbes et al. 2018, sec 2.1, Figs 1-2",

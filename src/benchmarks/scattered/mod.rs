@@ -123,6 +123,7 @@ const BASIS_PARAMS: &[ParamSpec] = &[
 
 pub const INFO_NODES: BenchmarkInfo = BenchmarkInfo {
     name: "recon1d_nodes",
+    kind: BenchmarkKind::Reconstruction,
     dim: 1,
     source: "Gong 2015, sec 4.3.1 and 5.2",
     description: "u sampled at equal or random points per cell, reconstructed at the grid nodes",
@@ -133,6 +134,7 @@ pub const INFO_NODES: BenchmarkInfo = BenchmarkInfo {
 
 pub const INFO_BASIS: BenchmarkInfo = BenchmarkInfo {
     name: "recon1d_basis",
+    kind: BenchmarkKind::OrthogonalBasis,
     dim: 1,
     source: "Tran et al. 2019, eq 16, Figs 1-3",
     description: "weighted orthogonal polynomials of given points, and u reconstructed from them",
@@ -140,15 +142,6 @@ pub const INFO_BASIS: BenchmarkInfo = BenchmarkInfo {
     check: check_basis,
     time_step: None,
 };
-
-pub(super) fn kind(name: &str) -> Option<BenchmarkKind> {
-    match name {
-        n if n == INFO_NODES.name => Some(BenchmarkKind::Reconstruction),
-        n if n == INFO_BASIS.name => Some(BenchmarkKind::OrthogonalBasis),
-        n if n == INFO_ELEMENTS.name => Some(BenchmarkKind::Elementwise),
-        _ => None,
-    }
-}
 
 /// One reconstruction problem, resolved from validated parameters.
 #[derive(Clone, Debug)]
@@ -168,7 +161,7 @@ impl ScatteredData {
         let (lower, upper) = interval(params)?;
         let cells = get_usize(params, "cells")?;
         let h = (upper - lower) / cells as f64;
-        let (points, basis_centre) = match kind(benchmark) {
+        let (points, basis_centre) = match super::CATALOG.find(benchmark).map(|b| b.kind) {
             Some(BenchmarkKind::OrthogonalBasis) => (
                 get_list(params, "points")?.to_vec(),
                 Some(get_f64(params, "centre")?),

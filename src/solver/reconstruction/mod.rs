@@ -22,8 +22,9 @@ const CURVE_SAMPLES: usize = 401;
 
 /// Runs one configuration, nodal or element-wise by the benchmark's kind.
 pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
-    let elementwise = benchmarks::info(&spec.benchmark)
-        .is_some_and(|info| benchmarks::kind(info) == BenchmarkKind::Elementwise);
+    let elementwise = benchmarks::CATALOG
+        .find(&spec.benchmark)
+        .is_some_and(|info| info.kind == BenchmarkKind::Elementwise);
     if elementwise {
         evaluate_elements(spec)
     } else {
@@ -77,13 +78,15 @@ fn prepare(
 }
 
 fn reconstruction_method(spec: &RunSpec) -> Result<&'static ReconstructionMethod, String> {
-    reconstruction_methods::method(&spec.method).ok_or_else(|| {
-        format!(
-            "unknown reconstruction method '{}'; valid: {}",
-            spec.method,
-            reconstruction_methods::method_names().join(", ")
-        )
-    })
+    reconstruction_methods::METHODS
+        .find(&spec.method)
+        .ok_or_else(|| {
+            format!(
+                "unknown reconstruction method '{}'; valid: {}",
+                spec.method,
+                reconstruction_methods::METHODS.names().join(", ")
+            )
+        })
 }
 
 /// An element-wise reconstruction: every element fitted on its own, errors at Gauss points.
