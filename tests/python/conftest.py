@@ -1,4 +1,5 @@
-"""The `run` fixture: every run file under $MPMLAB_RESULTS, one at a time.
+"""The `run` fixture: every run file under $MPMLAB_RESULTS, one at a time, each read once for
+all the test modules.
 """
 
 import pytest
@@ -6,6 +7,6 @@ import pytest
 from layout import RUN_FILES, Run, _file_id
 
 
-@pytest.fixture(scope="module", params=RUN_FILES, ids=[_file_id(p) for p in RUN_FILES])
+@pytest.fixture(scope="session", params=RUN_FILES, ids=[_file_id(p) for p in RUN_FILES])
 def run(request):
     return Run(request.param)
