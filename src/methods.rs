@@ -6,12 +6,13 @@ use std::fmt;
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
 use crate::benchmarks::scattered::MAX_GAUSS_POINTS;
 use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
-use crate::catalog::{Catalog, Named, Parts};
+use crate::catalog::{names_of, Catalog, Entry, Named, Parts};
+use crate::grid::Dofs;
 use crate::integrate::{IntegratorKind, INTEGRATORS, INTEGRATOR_NAMES};
 use crate::params::{get_f64, get_str, get_usize, ParamError, ParamValue, Params};
 use crate::reconstruct::{
-    BodyForceFit, TransferKind, IMLS, IMLS_CPLS, IMLS_EQ27, IMPM, IMPM_FIELDS, IMPM_VELOCITY, TLS,
-    TLS_LUMPED, TRANSFERS, TRANSFER_NAMES,
+    TransferKind, BODY_FORCE_FITS, BODY_FORCE_FIT_NAMES, IMLS, IMLS_CPLS, IMLS_EQ27, IMPM,
+    IMPM_FIELDS, IMPM_VELOCITY, TLS, TLS_LUMPED, TRANSFERS, TRANSFER_NAMES,
 };
 use crate::shape::{
     DomainShape, DualIntegrals, LmeParamError, LmeSettings, LocalMaxEnt, ShapeKind,
@@ -31,17 +32,26 @@ pub enum SampledVelocity {
     Centred,
 }
 
-impl SampledVelocity {
-    pub const NAMES: &'static [&'static str] = &["stepped", "centred"];
+const SAMPLED_VELOCITY_ENTRIES: &[Entry<SampledVelocity>] = &[
+    Entry {
+        name: "stepped",
+        value: SampledVelocity::Stepped,
+        description: "the whole-step velocity the scheme steps",
+    },
+    Entry {
+        name: "centred",
+        value: SampledVelocity::Centred,
+        description: "that velocity read as v^{s-1/2} and synchronised as the leapfrog's",
+    },
+];
 
-    fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "stepped" => Some(SampledVelocity::Stepped),
-            "centred" => Some(SampledVelocity::Centred),
-            _ => None,
-        }
-    }
-}
+pub const SAMPLED_VELOCITIES: Parts<SampledVelocity> = Catalog {
+    kind: "sampled_velocity",
+    entries: SAMPLED_VELOCITY_ENTRIES,
+};
+
+const SAMPLED_VELOCITY_NAMES: [&str; SAMPLED_VELOCITY_ENTRIES.len()] =
+    names_of(SAMPLED_VELOCITY_ENTRIES);
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Method {
@@ -430,7 +440,7 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         key: BODY_FORCE_FIT_KEY,
-        kind: ParamKind::Choice(BodyForceFit::NAMES),
+        kind: ParamKind::Choice(&BODY_FORCE_FIT_NAMES),
         default: ParamDefault::Text("the preset's"),
         unit: "",
         doc: "separate: rho and b fitted apart; product: one fit of rho_p b_p (quadrature \
@@ -438,7 +448,7 @@ pub const METHOD_PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         key: SAMPLED_VELOCITY_KEY,
-        kind: ParamKind::Choice(SampledVelocity::NAMES),
+        kind: ParamKind::Choice(&SAMPLED_VELOCITY_NAMES),
         default: ParamDefault::Text("stepped"),
         unit: "",
         doc: "the particle velocity MUSL and USL record: stepped, the whole-step velocity they \
@@ -516,17 +526,8 @@ pub fn resolve(preset: &MethodPreset, params: &Params, dim: usize) -> Result<Met
             recipe.gauss_points = get_usize(params, GAUSS_POINTS_KEY)?;
         }
         check_gauss_points(recipe.gauss_points, params, dim)?;
-        if params.contains_key(BODY_FORCE_FIT_KEY) {
-            let name = get_str(params, BODY_FORCE_FIT_KEY)?;
-            recipe.body_force = BodyForceFit::from_name(name).ok_or_else(|| {
-                ParamError::new(
-                    BODY_FORCE_FIT_KEY,
-                    format!(
-                        "unknown body_force_fit '{name}'; valid: {}",
-                        BodyForceFit::NAMES.join(", ")
-                    ),
-                )
-            })?;
+        if let Some(fit) = named_part(params, BODY_FORCE_FIT_KEY, &BODY_FORCE_FITS)? {
+            recipe.body_force = fit;
         }
     } else {
         refuse(
@@ -569,16 +570,8 @@ fn sampled_velocity(
     params: &Params,
     integrator: IntegratorKind,
 ) -> Result<SampledVelocity, ParamError> {
-    let name = get_str(params, SAMPLED_VELOCITY_KEY)?;
-    let sampled = SampledVelocity::from_name(name).ok_or_else(|| {
-        ParamError::new(
-            SAMPLED_VELOCITY_KEY,
-            format!(
-                "unknown sampled_velocity '{name}'; valid: {}",
-                SampledVelocity::NAMES.join(", ")
-            ),
-        )
-    })?;
+    let sampled = named_part(params, SAMPLED_VELOCITY_KEY, &SAMPLED_VELOCITIES)?
+        .expect("called where the run sets sampled_velocity");
     if matches!(integrator, IntegratorKind::Musl | IntegratorKind::Usl) {
         return Ok(sampled);
     }
@@ -663,34 +656,35 @@ fn runs_with(transfer: &TransferKind, integrator: IntegratorKind) -> bool {
 
 /// Why a shape function and a transfer cannot run together, if they cannot.
 pub fn check_parts(method: &Method) -> Result<(), String> {
-    let shape = method.shape.name();
-    let transfer = TRANSFERS
-        .name_of(&method.transfer)
-        .unwrap_or("this transfer");
-    let allowed: &[&str] = match method.transfer {
-        // The fits evaluate the hat at their own quadrature points.
-        TransferKind::Quadrature(_) => &["linear"],
-        // The velocity is fitted at the grid nodes, which the B-spline's DOFs are not.
-        TransferKind::FittedVelocity(_) => &[
-            "linear",
-            "ugimp",
-            "cpgimp",
-            "cpdi1",
-            "cpdi2",
-            "dual_domain",
-            "dual_domain_cells",
-            "lme",
-        ],
+    let (runs_on, reason): (fn(&ShapeKind) -> bool, &str) = match method.transfer {
+        TransferKind::Quadrature(_) => (
+            |shape| *shape == ShapeKind::Linear,
+            "its fits evaluate the linear hat at their own quadrature points",
+        ),
+        TransferKind::FittedVelocity(_) => (
+            |shape| shape.dofs() == Dofs::Nodes,
+            "it fits the velocity at the grid nodes, which must be the basis's DOFs",
+        ),
         TransferKind::ConsistentMass | TransferKind::Taylor(_) | TransferKind::Shepard => {
             return Ok(())
         }
     };
-    if allowed.contains(&shape) {
+    if runs_on(&method.shape) {
         return Ok(());
     }
+    let valid: Vec<&str> = SHAPES
+        .entries
+        .iter()
+        .filter(|e| runs_on(&e.value))
+        .map(|e| e.name)
+        .collect();
     Err(format!(
-        "the {transfer} transfer cannot run on the {shape} shape function; it runs on {}",
-        allowed.join(", ")
+        "the {} transfer cannot run on the {} shape function ({reason}); it runs on {}",
+        TRANSFERS
+            .name_of(&method.transfer)
+            .unwrap_or("this transfer"),
+        method.shape.name(),
+        valid.join(", ")
     ))
 }
 
@@ -832,6 +826,19 @@ mod tests {
                 && e.message.ends_with("it runs on linear"),
             "{}",
             e.message
+        );
+        let fitted = PRESETS.find("cpdi_mls").unwrap();
+        let e = resolve(
+            fitted,
+            &params(&[(SHAPE_KEY, text("quadratic_bspline"))]),
+            1,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.message,
+            "the mls_velocity transfer cannot run on the quadratic_bspline shape function (it fits \
+             the velocity at the grid nodes, which must be the basis's DOFs); it runs on linear, \
+             ugimp, cpgimp, cpdi1, cpdi2, dual_domain, dual_domain_cells, lme"
         );
         let composed = PRESETS.find(COMPOSED).unwrap();
         let tls_leapfrog = params(&[

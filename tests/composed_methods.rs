@@ -112,7 +112,8 @@ fn parts_that_cannot_run_together_are_refused_where_the_file_names_them() {
     assert_eq!((e.line, e.field.as_str()), (5, "matrix[0].shape[1]"), "{e}");
     assert!(
         e.message.contains(
-            "the imls transfer cannot run on the cpdi2 shape function; it runs on linear"
+            "the imls transfer cannot run on the cpdi2 shape function (its fits evaluate the \
+             linear hat at their own quadrature points); it runs on linear"
         ),
         "{e}"
     );

@@ -33,7 +33,10 @@ pub use least_squares::{
     FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,
 };
 pub use mass_matrix::{MassMatrix, MassSolver};
-pub use quadrature::{BodyForceFit, NodalVelocity, QuadratureRecipe, QuadratureTransfer};
+pub use quadrature::{
+    BodyForceFit, NodalVelocity, QuadratureRecipe, QuadratureTransfer, BODY_FORCE_FITS,
+    BODY_FORCE_FIT_NAMES,
+};
 pub use shepard::{map_velocity, nodal_forces, particles_to_grid, remap_velocity};
 pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
 pub use taylor::{taylor_terms, Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};

@@ -12,6 +12,7 @@ use num_traits::Zero;
 
 use super::shepard::{map_velocity, remap_velocity};
 use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments};
+use crate::catalog::{names_of, Catalog, Entry, Parts};
 use crate::grid::{Grid, GridState};
 use crate::particles::Particles;
 use crate::shape::{LinearHat, Shape, Stencils};
@@ -62,20 +63,33 @@ pub enum BodyForceFit {
     Product,
 }
 
+const BODY_FORCE_FIT_ENTRIES: &[Entry<BodyForceFit>] = &[
+    Entry {
+        name: "separate",
+        value: BodyForceFit::Separate,
+        description: "rho and b fitted apart and multiplied",
+    },
+    Entry {
+        name: "product",
+        value: BodyForceFit::Product,
+        description: "one fit of rho_p b_p",
+    },
+];
+
+/// The body-force fits by name: the `body_force_fit` parameter's choices.
+pub const BODY_FORCE_FITS: Parts<BodyForceFit> = Catalog {
+    kind: "body_force_fit",
+    entries: BODY_FORCE_FIT_ENTRIES,
+};
+
+pub const BODY_FORCE_FIT_NAMES: [&str; BODY_FORCE_FIT_ENTRIES.len()] =
+    names_of(BODY_FORCE_FIT_ENTRIES);
+
 impl BodyForceFit {
-    /// The names the `body_force_fit` parameter takes, in the order of `ALL`.
-    pub const NAMES: &'static [&'static str] = &["separate", "product"];
-    const ALL: [BodyForceFit; 2] = [BodyForceFit::Separate, BodyForceFit::Product];
-
     pub fn name(self) -> &'static str {
-        match self {
-            BodyForceFit::Separate => Self::NAMES[0],
-            BodyForceFit::Product => Self::NAMES[1],
-        }
-    }
-
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name)
+        BODY_FORCE_FITS
+            .name_of(&self)
+            .expect("every body-force fit is registered")
     }
 }
 

@@ -5,6 +5,7 @@ use std::fmt;
 
 use super::{DomainShape, DualIntegrals, DEFAULT_TOLERANCE};
 use crate::catalog::{names_of, Catalog, Entry, Parts};
+use crate::grid::Dofs;
 
 /// Basis functions used on the background grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +115,18 @@ pub const SHAPES: Parts<ShapeKind> = Catalog {
 pub const SHAPE_NAMES: [&str; ENTRIES.len()] = names_of(ENTRIES);
 
 impl ShapeKind {
+    /// Where the basis puts its DOFs: the B-spline's at the Greville abscissae, every other
+    /// basis's at the grid nodes.
+    pub fn dofs(&self) -> Dofs {
+        match self {
+            ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
+            ShapeKind::Linear
+            | ShapeKind::Domain(_)
+            | ShapeKind::DualDomain(_)
+            | ShapeKind::LocalMaxEnt(_) => Dofs::Nodes,
+        }
+    }
+
     /// Whether the basis takes the particles' domains from the seed lattice's sub-cells.
     pub fn reads_seed_domains(&self) -> bool {
         matches!(self, ShapeKind::Domain(_))

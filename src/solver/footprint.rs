@@ -8,7 +8,7 @@
 //! does not grow with the number of samples.
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
-use crate::grid::{Dofs, Grid};
+use crate::grid::Grid;
 use crate::methods::{self, Method};
 use crate::params::get_usize;
 use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe, TransferKind};
@@ -57,11 +57,7 @@ fn simulation_bytes<const D: usize>(
     ppc: f64,
 ) -> f64 {
     let d = D as f64;
-    let dofs = match method.shape {
-        ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
-        _ => Dofs::Nodes,
-    };
-    let grid = Grid::with_dofs(&problem.domain(), dofs);
+    let grid = Grid::with_dofs(&problem.domain(), method.shape.dofs());
     let cells = grid.cells as f64;
     let nodes = grid.num_nodes() as f64;
     let stencil = stencil_nodes::<D>(method.shape) as f64;

@@ -15,7 +15,7 @@ use nalgebra::SVector;
 
 use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
 use crate::divergence::Divergence;
-use crate::grid::{Dofs, FixedDof, Grid, GridState};
+use crate::grid::{FixedDof, Grid, GridState};
 use crate::integrate::predictor_corrector::PredictorCorrector;
 use crate::integrate::{self, leapfrog, musl, IntegratorKind};
 use crate::methods::{self, Method};
@@ -151,14 +151,7 @@ impl<'a, const D: usize> Run<'a, D> {
         mut problem: Box<dyn Problem<D>>,
         file: Option<&hdf5::File>,
     ) -> Self {
-        let dofs = match method.shape {
-            ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
-            ShapeKind::Linear
-            | ShapeKind::Domain(_)
-            | ShapeKind::DualDomain(_)
-            | ShapeKind::LocalMaxEnt(_) => Dofs::Nodes,
-        };
-        let grid = Grid::with_dofs(&problem.domain(), dofs);
+        let grid = Grid::with_dofs(&problem.domain(), method.shape.dofs());
         let particles = problem.seed_particles(&grid);
         problem.attach_particles(&particles.x0);
         let fixed = fixed_dofs(&grid, &problem.fixed_faces());
