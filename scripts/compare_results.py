@@ -6,7 +6,7 @@ For every experiment directory of A (one with an experiment.yaml) B must have th
 experiment.yaml, the same run files and no temporary files left, and every pair of run files
 must hold the same groups, datasets and attributes: every dataset with the same dtype, shape
 and bytes, every attribute equal. Excluded, because it records time: the root attribute
-`wall_seconds` of each run file (and timings.csv, which is not compared). B must have the same
+`wall_seconds` of each run file (and timings.csv and costs.md, which are not compared). B must have the same
 XDMF descriptions (<run_id>.xdmf), byte for byte. The report files
 (summary.csv, rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
 Exits 1 listing the differences.

@@ -532,7 +532,7 @@ fn benchmarks_json() -> Value {
             json!({
                 "name": b.name,
                 "kind": b.kind.to_string(),
-                "dim": b.dim,
+                "dim": b.dim(),
                 "source": b.source,
                 "description": b.description,
                 "params": b.params.iter().map(param_json).collect::<Vec<_>>(),
@@ -601,16 +601,10 @@ fn list_methods() {
 fn list_benchmarks() {
     for b in benchmarks::CATALOG.entries {
         let kind = b.kind;
-        // The element-wise benchmark runs in its function's dimension, shape_functions in its
-        // `dim`.
-        let varies = [
-            benchmarks::BenchmarkKind::Elementwise,
-            benchmarks::BenchmarkKind::ShapeFunctions,
-        ];
-        let dims = if varies.contains(&kind) {
-            format!("1D or {}D", b.dim)
-        } else {
-            format!("{}D", b.dim)
+        // Runs that build no problem take the dimension of their parameters, up to `dim`.
+        let dims = match b.build {
+            benchmarks::Build::Points { dim } if dim > 1 => format!("1D or {dim}D"),
+            _ => format!("{}D", b.dim()),
         };
         println!(
             "{} ({dims}, {kind}) - {} [{}]",

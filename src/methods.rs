@@ -15,7 +15,7 @@ use crate::reconstruct::{
     IMPM_FIELDS, IMPM_VELOCITY, TLS, TLS_LUMPED, TRANSFERS, TRANSFER_NAMES,
 };
 use crate::shape::{
-    DomainShape, DualIntegrals, LmeParamError, LmeSettings, LocalMaxEnt, ShapeKind,
+    DomainShape, DualIntegrals, LmeParamError, LmeSettings, LocalMaxEnt, ShapeKind, SplineDegree,
     DEFAULT_TOLERANCE, LME_UNSET, SHAPES, SHAPE_NAMES,
 };
 
@@ -291,13 +291,28 @@ pub const PRESETS: Catalog<MethodPreset> = Catalog {
         },
         MethodPreset {
             name: "bsmpm",
-            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Shepard),
+            method: musl_on(
+                ShapeKind::BSpline(SplineDegree::Quadratic),
+                TransferKind::Shepard,
+            ),
             source: "Steffen et al. 2008; Tielen et al. 2017; Wobbes et al. 2018",
             description: "B-spline MPM: quadratic B-splines, open knot vector, lumped mass, MUSL",
         },
         MethodPreset {
+            name: "bsmpm_cubic",
+            method: musl_on(
+                ShapeKind::BSpline(SplineDegree::Cubic),
+                TransferKind::Shepard,
+            ),
+            source: "Steffen et al. 2008, with the cubic B-spline",
+            description: "B-spline MPM: cubic B-splines, open knot vector, lumped mass, MUSL",
+        },
+        MethodPreset {
             name: "bsmpm_consistent",
-            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::ConsistentMass),
+            method: musl_on(
+                ShapeKind::BSpline(SplineDegree::Quadratic),
+                TransferKind::ConsistentMass,
+            ),
             source: "Wobbes et al. 2018, eq 8 with the consistent mass matrix",
             description:
                 "B-spline MPM with the consistent mass matrix of the particle quadrature, \
@@ -328,14 +343,17 @@ pub const PRESETS: Catalog<MethodPreset> = Catalog {
         },
         MethodPreset {
             name: "bsmpm_tls",
-            method: musl_on(ShapeKind::QuadraticBSpline, TransferKind::Taylor(TLS)),
+            method: musl_on(
+                ShapeKind::BSpline(SplineDegree::Quadratic),
+                TransferKind::Taylor(TLS),
+            ),
             source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3",
             description: "B-spline MPM with the conservative TLS mapping on each knot span, MUSL",
         },
         MethodPreset {
             name: "bsmpm_tls_lumped",
             method: musl_on(
-                ShapeKind::QuadraticBSpline,
+                ShapeKind::BSpline(SplineDegree::Quadratic),
                 TransferKind::Taylor(TLS_LUMPED),
             ),
             source: "Wobbes, Moller, Galavi, Vuik 2018, sec 3 (lumped option)",

@@ -230,7 +230,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
 pub fn estimated_cost(run: &RunSpec) -> u64 {
     let dim = crate::benchmarks::CATALOG
         .find(&run.benchmark)
-        .map_or(1, |b| b.dim) as u32;
+        .map_or(1, |b| b.dim()) as u32;
     let cells = get_usize(&run.params, "cells").unwrap_or(1) as u64;
     let ppc = get_usize(&run.params, "ppc").unwrap_or(1) as u64;
     let particles = cells.saturating_mul(ppc).saturating_pow(dim);

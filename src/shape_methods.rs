@@ -1,8 +1,9 @@
 //! The catalogue of grid bases, the `method` of the `shape_functions` benchmark: the LME basis
 //! of Molinos et al. and, for comparison, the hat it tends to for large gamma and the quadratic
-//! B-spline.
+//! and cubic B-splines.
 
 use crate::catalog::{Catalog, Named};
+use crate::shape::SplineDegree;
 use std::fmt;
 
 /// Which basis a method evaluates.
@@ -12,17 +13,17 @@ pub enum Basis {
     Lme,
     /// The piecewise-linear hat.
     Linear,
-    /// The quadratic B-spline, its DOFs at the Greville abscissae.
-    QuadraticBSpline,
+    /// A B-spline, its DOFs at the Greville abscissae.
+    BSpline(SplineDegree),
 }
 
 impl fmt::Display for Basis {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Basis::Lme => "lme",
-            Basis::Linear => "linear",
-            Basis::QuadraticBSpline => "quadratic_bspline",
-        })
+        match self {
+            Basis::Lme => f.write_str("lme"),
+            Basis::Linear => f.write_str("linear"),
+            Basis::BSpline(degree) => write!(f, "{}_bspline", degree.word()),
+        }
     }
 }
 
@@ -56,9 +57,15 @@ pub const METHODS: Catalog<ShapeMethod> = Catalog {
         },
         ShapeMethod {
             name: "quadratic_bspline",
-            basis: Basis::QuadraticBSpline,
+            basis: Basis::BSpline(SplineDegree::Quadratic),
             source: "Steffen et al. 2008; Wobbes et al. 2018",
             description: "quadratic B-spline on the open knot vector",
+        },
+        ShapeMethod {
+            name: "cubic_bspline",
+            basis: Basis::BSpline(SplineDegree::Cubic),
+            source: "de Boor 1978; Steffen et al. 2008",
+            description: "cubic B-spline on the open knot vector",
         },
     ],
 };

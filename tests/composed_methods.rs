@@ -129,3 +129,59 @@ fn parts_that_cannot_run_together_are_refused_where_the_file_names_them() {
     let e = experiment::parse(&alone, Path::new("parts.yaml")).unwrap_err();
     assert!(e.message.contains("'method' is required"), "{e}");
 }
+
+/// experiments/component_matrix*.yaml run every combination of parts that `methods::resolve`
+/// accepts, each once, and nothing else: a new part, or a rule that changes, fails here until
+/// the component matrices follow it.
+#[test]
+fn the_component_matrices_run_every_valid_combination_once() {
+    use mpmlab::integrate::INTEGRATOR_NAMES;
+    use mpmlab::methods::{resolve, PRESETS, SHAPE_KEY, TRANSFER_KEY};
+    use mpmlab::reconstruct::TRANSFER_NAMES;
+    use mpmlab::shape::SHAPE_NAMES;
+    use std::collections::BTreeSet;
+
+    let composed = PRESETS.find(COMPOSED).unwrap();
+    let mut valid = BTreeSet::new();
+    for shape in SHAPE_NAMES {
+        for transfer in TRANSFER_NAMES {
+            for integrator in INTEGRATOR_NAMES {
+                // The parts as a run of the component matrix on Gong's problem names them.
+                let mut params = thesis_params(0.1, 16, 2);
+                params.insert(SHAPE_KEY.into(), text(shape));
+                params.insert(TRANSFER_KEY.into(), text(transfer));
+                params.insert("integrator".into(), text(integrator));
+                if shape == "lme" {
+                    params.insert(GAMMA_KEY.into(), ParamValue::Float(1.8));
+                }
+                if resolve(composed, &params, 1).is_ok() {
+                    valid.insert([shape, transfer, integrator].map(String::from));
+                }
+            }
+        }
+    }
+    for file in [
+        "experiments/component_matrix.yaml",
+        "experiments/component_matrix_dyka.yaml",
+    ] {
+        let e = experiment::load(Path::new(file)).unwrap();
+        let parts: Vec<[String; 3]> = e
+            .runs
+            .iter()
+            .map(|r| {
+                ["shape", "transfer", "integrator"].map(|k| match r.params.get(k) {
+                    Some(ParamValue::Str(s)) => s.clone(),
+                    other => panic!("{file}: {}: {k} is {other:?}", r.run_id),
+                })
+            })
+            .collect();
+        let ran: BTreeSet<[String; 3]> = parts.iter().cloned().collect();
+        assert_eq!(ran.len(), parts.len(), "{file} runs a combination twice");
+        let missing: Vec<_> = valid.difference(&ran).collect();
+        let extra: Vec<_> = ran.difference(&valid).collect();
+        assert!(
+            missing.is_empty() && extra.is_empty(),
+            "{file}: missing {missing:?}, not valid {extra:?}"
+        );
+    }
+}

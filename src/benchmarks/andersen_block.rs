@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use nalgebra::{SMatrix, SVector, Vector2};
 
 use super::limits::{check_lattice, courant_time_step};
-use super::BenchmarkKind;
+use super::{boxed, BenchmarkKind, Build};
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
@@ -110,7 +110,7 @@ const PARAMS: &[ParamSpec] = &[
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "andersen_block",
     kind: BenchmarkKind::Simulation,
-    dim: 2,
+    build: Build::Plane(|params| boxed(andersen_block(params))),
     source: "Molinos et al., sec 6.2, eq 41 (Andersen 2009)",
     description: "elastic block on a rigid base under gravity ramped up by eq 41; probes \
                   top_displacement, bottom_stress",

@@ -11,7 +11,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::limits::{check_lattice, courant_time_step};
-use super::BenchmarkKind;
+use super::{boxed, BenchmarkKind, Build};
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
@@ -87,7 +87,7 @@ const PARAMS: &[ParamSpec] = &[
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "dyka_bar",
     kind: BenchmarkKind::Simulation,
-    dim: 1,
+    build: Build::Line(|params| boxed(dyka_bar(params))),
     source: "Molinos et al., sec 6.1, appendix A (Dyka & Ingel 1995)",
     description: "linear-elastic bar, x = 0 fixed, x = L free, v0 on the last quarter; probes \
                   free_end_velocity, quarter_stress, mid_stress",

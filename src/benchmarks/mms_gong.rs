@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use super::limits::{check_lattice, courant_time_step};
 use super::sine_mms::{SineMms, SineMmsSpec, SineWave, CELLS, PPC, RHO0};
-use super::BenchmarkKind;
+use super::{boxed, BenchmarkKind, Build};
 use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{lame_from_young, NeoHookean};
 use crate::params::{get_f64, get_usize};
@@ -63,7 +63,7 @@ const PARAMS: &[ParamSpec] = &[
 pub const INFO_1D: BenchmarkInfo = BenchmarkInfo {
     name: "mms1d_gong",
     kind: BenchmarkKind::Simulation,
-    dim: 1,
+    build: Build::Line(|params| boxed(gong_mms::<1>(params))),
     source: "Gong 2015, eqs 4.35-4.39",
     description: "neo-Hookean bar on [0,1], fixed ends, manufactured solution",
     params: PARAMS,
@@ -74,7 +74,7 @@ pub const INFO_1D: BenchmarkInfo = BenchmarkInfo {
 pub const INFO_2D: BenchmarkInfo = BenchmarkInfo {
     name: "mms2d_gong",
     kind: BenchmarkKind::Simulation,
-    dim: 2,
+    build: Build::Plane(|params| boxed(gong_mms::<2>(params))),
     source: "Gong 2015, eqs 4.41-4.46",
     description: "plane-strain neo-Hookean square [0,1]^2, roller walls, manufactured solution",
     params: PARAMS,

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::limits::{check_lattice, given_time_step};
 use super::sine_mms::{SineMms, SineMmsSpec, SineWave, CELLS, PPC, RHO0};
-use super::BenchmarkKind;
+use super::{boxed, BenchmarkKind, Build};
 use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{young_from_lame, NeoHookean};
 use crate::params::{get_f64, get_usize};
@@ -62,7 +62,7 @@ const PARAMS: &[ParamSpec] = &[
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "mms1d_tran",
     kind: BenchmarkKind::Simulation,
-    dim: 1,
+    build: Build::Line(|params| boxed(tran_mms(params))),
     source: "Tran, Berzins & Solowski 2019, eqs 41-48",
     description: "neo-Hookean bar on [0,L], fixed ends, manufactured solution",
     params: PARAMS,

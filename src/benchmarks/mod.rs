@@ -78,8 +78,8 @@ pub struct BenchmarkInfo {
     pub name: &'static str,
     /// What its runs do, which decides what they record.
     pub kind: BenchmarkKind,
-    /// The spatial dimension; for `recon_tls`, whose runs take their function's, the largest.
-    pub dim: usize,
+    /// What a run builds, which fixes its dimension.
+    pub build: Build,
     pub source: &'static str,
     pub description: &'static str,
     pub params: &'static [ParamSpec],
@@ -89,6 +89,45 @@ pub struct BenchmarkInfo {
     /// The time step of a run, which its check approves and its problem takes; `None` for a
     /// benchmark that does not step in time.
     pub time_step: Option<TimeStepFn>,
+}
+
+/// A simulation's problem in `D` dimensions from validated parameters.
+pub type ProblemFn<const D: usize> = fn(&Params) -> Result<Box<dyn Problem<D>>, ParamError>;
+
+/// What a benchmark builds for a run: a simulation its problem, in 1D or 2D; the other kinds
+/// nothing, evaluating data or a basis at points in up to `dim` dimensions (each run takes
+/// the dimension of its own parameters).
+#[derive(Clone, Copy)]
+pub enum Build {
+    Line(ProblemFn<1>),
+    Plane(ProblemFn<2>),
+    Points { dim: usize },
+}
+
+impl BenchmarkInfo {
+    /// The spatial dimension; for benchmarks whose runs choose theirs, the largest.
+    pub fn dim(&self) -> usize {
+        match self.build {
+            Build::Line(_) => 1,
+            Build::Plane(_) => 2,
+            Build::Points { dim } => dim,
+        }
+    }
+
+    /// The problem of a simulation run from validated parameters.
+    pub fn problem(&self, params: &Params) -> Result<AnyProblem, ParamError> {
+        match self.build {
+            Build::Line(build) => build(params).map(AnyProblem::D1),
+            Build::Plane(build) => build(params).map(AnyProblem::D2),
+            Build::Points { .. } => Err(ParamError::new(
+                "benchmark",
+                format!(
+                    "{} is not a simulation: its runs build no problem",
+                    self.name
+                ),
+            )),
+        }
+    }
 }
 
 /// How a simulation benchmark's runs step (`BenchmarkInfo::time_step`).
@@ -327,25 +366,27 @@ pub enum AnyProblem {
     D2(Box<dyn Problem<2>>),
 }
 
-/// Builds the named benchmark from validated parameters.
+/// Builds the named simulation benchmark from validated parameters.
 pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
-    match name {
-        "mms1d_gong" => Ok(AnyProblem::D1(Box::new(gong_mms::<1>(params)?))),
-        "mms2d_gong" => Ok(AnyProblem::D2(Box::new(gong_mms::<2>(params)?))),
-        "mms1d_tran" => Ok(AnyProblem::D1(Box::new(mms_tran::tran_mms(params)?))),
-        "vibrating_bar" => Ok(AnyProblem::D1(Box::new(vibrating_bar(params)?))),
-        "dyka_bar" => Ok(AnyProblem::D1(Box::new(dyka_bar::dyka_bar(params)?))),
-        "andersen_block" => Ok(AnyProblem::D2(Box::new(andersen_block::andersen_block(
-            params,
-        )?))),
-        other => Err(ParamError::new(
-            "benchmark",
-            format!(
-                "unknown benchmark '{other}'; valid: {}",
-                CATALOG.names().join(", ")
-            ),
-        )),
-    }
+    CATALOG
+        .find(name)
+        .ok_or_else(|| {
+            ParamError::new(
+                "benchmark",
+                format!(
+                    "unknown benchmark '{name}'; valid: {}",
+                    CATALOG.names().join(", ")
+                ),
+            )
+        })?
+        .problem(params)
+}
+
+/// Boxes a benchmark's problem for `Build`.
+fn boxed<P: Problem<D> + 'static, const D: usize>(
+    problem: Result<P, ParamError>,
+) -> Result<Box<dyn Problem<D>>, ParamError> {
+    Ok(Box::new(problem?))
 }
 
 #[cfg(test)]
@@ -365,6 +406,24 @@ mod tests {
             }
         }
         params
+    }
+
+    /// A simulation builds a problem and every other kind builds none, so a benchmark's kind
+    /// and its constructor cannot disagree.
+    #[test]
+    fn simulations_and_only_simulations_build_a_problem() {
+        for info in CATALOG.entries {
+            let builds = matches!(info.build, Build::Line(_) | Build::Plane(_));
+            assert_eq!(builds, info.kind.steps(), "{}", info.name);
+            if builds {
+                let problem = info.problem(&runnable_params(info));
+                assert!(problem.is_ok(), "{}", info.name);
+            } else {
+                assert!(info.problem(&Params::new()).is_err(), "{}", info.name);
+            }
+        }
+        let dims: Vec<usize> = CATALOG.entries.iter().map(BenchmarkInfo::dim).collect();
+        assert_eq!(dims, [1, 2, 1, 1, 1, 2, 1, 1, 2, 2]);
     }
 
     /// `exact_on_grid` lists exactly the simulation benchmarks whose problem inverts its

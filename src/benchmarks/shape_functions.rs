@@ -5,7 +5,7 @@
 use nalgebra::SVector;
 
 use super::limits::{check_count, largest, per_axis_total, power};
-use super::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, BenchmarkKind, Build, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
 use crate::params::{get_f64, get_usize, ParamError, Params};
 use crate::shape::{LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE};
@@ -52,9 +52,10 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "shape_functions",
     kind: BenchmarkKind::ShapeFunctions,
     // Runs take the dimension of their `dim`; this is the largest.
-    dim: 2,
+    build: Build::Points { dim: 2 },
     source: "Molinos et al., sec 5, Fig 3",
-    description: "a grid basis (LME, hat, quadratic B-spline) and its gradient on a lattice of \
+    description:
+        "a grid basis (LME, hat, quadratic or cubic B-spline) and its gradient on a lattice of \
                   points, with its consistency errors",
     params: PARAMS,
     check,

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 use nalgebra::{SMatrix, SVector};
 
 use super::limits::{check_lattice, given_time_step};
-use super::BenchmarkKind;
+use super::{boxed, BenchmarkKind, Build};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use super::{ParamError, Params, Problem, TimeStep};
 use crate::grid::Domain;
@@ -88,7 +88,7 @@ const PARAMS: &[ParamSpec] = &[
 pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "vibrating_bar",
     kind: BenchmarkKind::Simulation,
-    dim: 1,
+    build: Build::Line(|params| boxed(vibrating_bar(params))),
     source: "Wobbes et al. 2018, sec 5, eq 15, Tables 1-2",
     description: "linear-elastic bar on [0,H], fixed ends, sine initial velocity",
     params: PARAMS,

@@ -204,7 +204,7 @@ fn check_method_params(
     params: &Params,
 ) -> Result<(), ParamError> {
     if let Some(preset) = methods::PRESETS.find(method) {
-        return methods::resolve(preset, params, benchmark.info.dim).map(drop);
+        return methods::resolve(preset, params, benchmark.info.dim()).map(drop);
     }
     match methods::METHOD_PARAMS
         .iter()
@@ -319,7 +319,9 @@ fn check_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmarks::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
+    use crate::benchmarks::{
+        BenchmarkInfo, BenchmarkKind, Build, ParamDefault, ParamKind, ParamSpec,
+    };
     use crate::experiment::space::{Axis, Block};
     use crate::experiment::values::ValueKind;
     use crate::params::ParamValue;
@@ -341,7 +343,7 @@ mod tests {
     const TOY: BenchmarkInfo = BenchmarkInfo {
         name: "toy",
         kind: BenchmarkKind::Simulation,
-        dim: 1,
+        build: Build::Line(|_| Err(ParamError::new("x", "the toy has no problem"))),
         source: "",
         description: "",
         params: &[

@@ -302,6 +302,9 @@ pub enum TableKind {
     /// One row per run: its axis values and its final error in one field and norm (Molinos
     /// eq 40 with velocity and rms).
     Errors,
+    /// One row per run, from the smallest final error in one field and norm to the largest
+    /// (and in costs.md from the shortest wall time to the longest).
+    Ranking,
     /// One row per run: how a probe's history settles against its reference after a time
     /// (Molinos Figs 10-11: which runs stay stable, when the others leave).
     Probes,

@@ -24,7 +24,7 @@ pub(crate) fn read(
     let Some(section) = section else {
         return Ok(None);
     };
-    if kind != BenchmarkKind::Simulation || info.dim != 1 {
+    if kind != BenchmarkKind::Simulation || info.dim() != 1 {
         return Err(ConfigError::at(
             section.key_pos,
             FIELD,

@@ -24,6 +24,7 @@ const KINDS: Kinds<TableKind> = Kinds {
         ("stability", TableKind::Stability),
         ("element_fits", TableKind::ElementFits),
         ("errors", TableKind::Errors),
+        ("ranking", TableKind::Ranking),
         ("probes", TableKind::Probes),
         ("conservation", TableKind::Conservation),
     ],
@@ -87,14 +88,21 @@ fn table(
         _ => None,
     };
     let measure = match kind {
-        TableKind::Errors => {
+        TableKind::Errors | TableKind::Ranking => {
             let field = match find(&entries, "field") {
                 Some(e) => error_field(e.value, &child_field(parent, "field"), measures)?,
                 None => {
                     return Err(ConfigError::at(
                         node.pos,
                         child_field(parent, "field"),
-                        "an errors table needs 'field': the error it lists",
+                        format!(
+                            "{} table needs 'field': the error it lists",
+                            if *kind == TableKind::Ranking {
+                                "a ranking"
+                            } else {
+                                "an errors"
+                            }
+                        ),
                     )
                     .with_valid(measures.fields))
                 }
@@ -153,7 +161,7 @@ fn takes(kind: &TableKind) -> &'static [&'static str] {
         TableKind::NodalErrors => &["columns"],
         TableKind::BasisNorms | TableKind::ElementFits | TableKind::Conservation => &[],
         TableKind::Stability => &["x", "sweep"],
-        TableKind::Errors => &["field", "norm"],
+        TableKind::Errors | TableKind::Ranking => &["field", "norm"],
         TableKind::Probes => &["probe", "after", "tolerance"],
     }
 }
@@ -168,7 +176,7 @@ fn lists_for(kind: &TableKind, benchmark: BenchmarkKind) -> bool {
         TableKind::BasisNorms => benchmark == BenchmarkKind::OrthogonalBasis,
         TableKind::Stability => benchmark == BenchmarkKind::Simulation,
         TableKind::ElementFits => benchmark == BenchmarkKind::Elementwise,
-        TableKind::Errors => true,
+        TableKind::Errors | TableKind::Ranking => true,
         TableKind::Probes | TableKind::Conservation => benchmark == BenchmarkKind::Simulation,
     }
 }

@@ -262,7 +262,10 @@ mod tests {
         let ok = normalize(bases, &node("lme"), "params.method");
         assert_eq!(ok, Ok(ParamValue::Str("lme".into())));
         let e = normalize(bases, &node("mpm"), "params.method").unwrap_err();
-        assert_eq!(e.valid, ["lme", "linear", "quadratic_bspline"]);
+        assert_eq!(
+            e.valid,
+            ["lme", "linear", "quadratic_bspline", "cubic_bspline"]
+        );
     }
 
     #[test]

@@ -15,9 +15,10 @@ pub use state::{FixedDof, GridState};
 pub enum Dofs {
     /// One per grid node, cells + 1 per axis: the hat and the shapes built on it.
     Nodes,
-    /// The quadratic B-spline on the open knot vector 0, 0, 0, h, 2h, ..., L, L, L:
-    /// cells + 2 per axis, at the Greville abscissae 0, h/2, 3h/2, ..., L - h/2, L.
-    QuadraticSpline,
+    /// The B-spline of `degree` on the open knot vector (each end knot repeated degree + 1
+    /// times): cells + degree per axis, at the Greville abscissae (for the quadratic one
+    /// 0, h/2, 3h/2, ..., L - h/2, L).
+    BSpline { degree: usize },
 }
 
 /// A uniform background grid: `cells` cells of size `h` per direction, and the DOFs of its
@@ -46,7 +47,7 @@ impl<const D: usize> Grid<D> {
         let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
         let n = match dofs {
             Dofs::Nodes => domain.cells + 1,
-            Dofs::QuadraticSpline => domain.cells + 2,
+            Dofs::BSpline { degree } => domain.cells + degree,
         };
         let strides = lattice_strides(&[n; D]);
         Grid {
@@ -70,7 +71,7 @@ impl<const D: usize> Grid<D> {
         self.num_nodes
     }
 
-    /// DOFs (nodes) per axis: cells + 1 for the hat, cells + 2 for the quadratic B-spline.
+    /// DOFs (nodes) per axis: cells + 1 for the hat, cells + degree for a B-spline.
     pub fn nodes_per_dim(&self) -> usize {
         self.per_axis
     }
@@ -81,7 +82,13 @@ impl<const D: usize> Grid<D> {
     pub fn dof_coordinate(&self, axis: usize, i: usize) -> f64 {
         let in_cells = match self.dofs {
             Dofs::Nodes => i as f64,
-            Dofs::QuadraticSpline => (i as f64 - 0.5).clamp(0.0, self.cells as f64),
+            // The mean of the knots t_{i+1}, ..., t_{i+degree}, t_j = clamp(j - degree, 0, cells).
+            Dofs::BSpline { degree } => {
+                let knots: usize = (i + 1..=i + degree)
+                    .map(|j| j.saturating_sub(degree).min(self.cells))
+                    .sum();
+                knots as f64 / degree as f64
+            }
         };
         self.lower[axis] + in_cells * self.h
     }

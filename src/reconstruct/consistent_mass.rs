@@ -77,7 +77,7 @@ mod tests {
     use crate::grid::{Dofs, Domain, Grid};
     use crate::particles::SeedLattice;
     use crate::reconstruct::remap_velocity;
-    use crate::shape::{QuadraticBSpline, Shape};
+    use crate::shape::{Shape, SplineDegree};
     use nalgebra::SMatrix;
 
     /// The open quadratic B-spline on [0, cells] (h = 1) with three particles of unit mass per
@@ -95,7 +95,7 @@ mod tests {
                 upper: SVector::repeat(length),
                 cells,
             },
-            Dofs::QuadraticSpline,
+            SplineDegree::Quadratic.dofs(),
         );
         let n = ppc * cells;
         let spacing = length / n as f64;
@@ -118,9 +118,9 @@ mod tests {
                 per_axis: [n],
             },
         };
-        let mut stencils = Stencils::new(Shape::<1>::nodes_per_point(&QuadraticBSpline), n);
+        let mut stencils = Stencils::new(SplineDegree::Quadratic.shape::<1>().nodes_per_point(), n);
         stencils
-            .update(&QuadraticBSpline, &grid, &particles.x)
+            .update(SplineDegree::Quadratic.shape(), &grid, &particles.x)
             .unwrap();
         (grid, particles, stencils)
     }
@@ -201,7 +201,7 @@ mod tests {
         let (grid, _, _) = boundary_spans(2);
         let mut at_end = Stencils::new(3, 1);
         at_end
-            .update(&QuadraticBSpline, &grid, &[SVector::zeros()])
+            .update(SplineDegree::Quadratic.shape(), &grid, &[SVector::zeros()])
             .unwrap();
         let slope = |v: &[f64]| -> f64 {
             at_end
@@ -233,7 +233,7 @@ mod tests {
             particles.stress[p][(0, 0)] = 1e3 * (rng.unit() - 0.5);
         }
         stencils
-            .update(&QuadraticBSpline, &grid, &particles.x)
+            .update(SplineDegree::Quadratic.shape(), &grid, &particles.x)
             .unwrap();
         let body = vec![SVector::zeros(); particles.len()];
         let mut nodes = GridState::new(grid.num_nodes(), 1.0);
@@ -316,7 +316,7 @@ mod tests {
     /// projection of v = (1 + 2x - y, 3 - x + 4y) from jittered particles of random mass is
     /// still exact at every DOF that carries mass, with the lumped preconditioner (the hat)
     /// and with the line sums (the quadratic B-spline).
-    fn check_iterative_solve_2d<S: Shape<2>>(shape: &S, dofs: Dofs, with_lines: bool) {
+    fn check_iterative_solve_2d<S: Shape<2> + ?Sized>(shape: &S, dofs: Dofs, with_lines: bool) {
         use crate::benchmarks::Problem;
         let prob = crate::benchmarks::gong_mms::<2>(&crate::benchmarks::thesis_params(1e-4, 32, 2))
             .unwrap();
@@ -366,6 +366,10 @@ mod tests {
     #[test]
     fn the_iterative_solve_reproduces_linear_fields_in_2d() {
         check_iterative_solve_2d(&crate::shape::LinearHat, Dofs::Nodes, false);
-        check_iterative_solve_2d(&QuadraticBSpline, Dofs::QuadraticSpline, true);
+        check_iterative_solve_2d(
+            SplineDegree::Quadratic.shape(),
+            SplineDegree::Quadratic.dofs(),
+            true,
+        );
     }
 }

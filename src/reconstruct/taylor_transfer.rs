@@ -371,8 +371,7 @@ impl fmt::Display for TaylorRecipe {
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, Problem};
-    use crate::grid::Dofs;
-    use crate::shape::{LinearHat, QuadraticBSpline};
+    use crate::shape::{LinearHat, SplineDegree};
 
     fn recipe(mass: MassMatrix) -> TaylorRecipe {
         TaylorRecipe {
@@ -430,9 +429,11 @@ mod tests {
         let scale: f64 = (0..particles.len())
             .map(|p| particles.v[p].norm() * particles.mass[p])
             .sum();
-        let spline_grid = Grid::with_dofs(&domain(&grid), Dofs::QuadraticSpline);
-        let bases: [(&Grid<D>, &dyn Shape<D>); 2] =
-            [(&grid, &LinearHat), (&spline_grid, &QuadraticBSpline)];
+        let spline_grid = Grid::with_dofs(&domain(&grid), SplineDegree::Quadratic.dofs());
+        let bases: [(&Grid<D>, &dyn Shape<D>); 2] = [
+            (&grid, &LinearHat),
+            (&spline_grid, SplineDegree::Quadratic.shape()),
+        ];
         for ((grid, shape), kind) in bases
             .into_iter()
             .flat_map(|b| [(b, MassMatrix::Consistent), (b, MassMatrix::Lumped)])

@@ -17,6 +17,7 @@ mod markdown;
 mod plot;
 mod pointwise;
 mod probe_table;
+mod ranking;
 pub mod stability;
 mod style;
 mod table;
@@ -115,6 +116,9 @@ pub fn write_report(
         (dir.join("rates.csv"), tables::rates_csv(rates).into()),
         (dir.join("report.md"), md.into()),
     ]);
+    if let Some(costs) = ranking::costs_md(experiment, runs) {
+        outputs.push((dir.join("costs.md"), costs.into()));
+    }
     write_all_atomically(&outputs)?;
     let files: Vec<PathBuf> = figures
         .iter()

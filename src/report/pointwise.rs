@@ -7,6 +7,7 @@
 use super::format::general;
 use super::group::{group_runs, label, ordered_runs, scoped_label, selects, title_suffix};
 use super::probe_table;
+use super::ranking;
 use super::stability;
 use super::table::{per_run_rows, Table};
 use crate::experiment::{Experiment, TableKind, TableSpec};
@@ -24,6 +25,7 @@ pub fn tables(experiment: &Experiment, runs: &[RunSummary]) -> Result<Vec<Table>
             TableKind::Stability => tables.extend(stability::tables(selected, spec)),
             TableKind::ElementFits => tables.extend(element_fits(experiment, selected)),
             TableKind::Errors => tables.extend(final_errors(experiment, selected, spec)),
+            TableKind::Ranking => tables.extend(ranking::by_error(experiment, selected, spec)),
             TableKind::Probes => tables.extend(probe_table::table(experiment, selected, spec)?),
             TableKind::Conservation => tables.extend(conservation(experiment, selected, spec)),
         }

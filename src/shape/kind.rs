@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use super::{DomainShape, DualIntegrals, DEFAULT_TOLERANCE};
+use super::{DomainShape, DualIntegrals, SplineDegree, DEFAULT_TOLERANCE};
 use crate::catalog::{names_of, Catalog, Entry, Parts};
 use crate::grid::Dofs;
 
@@ -14,9 +14,10 @@ pub enum ShapeKind {
     Linear,
     /// The hat averaged over each particle's domain (GIMP, CPDI; Gong ch. 6).
     Domain(DomainShape),
-    /// Quadratic B-splines on the open knot vector 0, 0, 0, h, ..., L, L, L (tensor product
-    /// in 2D): cells + 2 DOFs per axis (BSMPM; Steffen et al. 2008, Tielen et al. 2017).
-    QuadraticBSpline,
+    /// B-splines on the open knot vector, e.g. 0, 0, 0, h, ..., L, L, L for the quadratic
+    /// (tensor product in 2D): cells + degree DOFs per axis (BSMPM; Steffen et al. 2008,
+    /// Tielen et al. 2017).
+    BSpline(SplineDegree),
     /// The hat's values with the dual-domain gradient, the hat's gradient averaged over the
     /// material under each node's hat (DDMPM; Zhang, Ma & Giguere 2011), the integrals taken
     /// as given.
@@ -39,7 +40,7 @@ impl fmt::Display for ShapeKind {
         match self {
             ShapeKind::Linear => f.write_str("linear"),
             ShapeKind::Domain(shape) => write!(f, "domain({shape})"),
-            ShapeKind::QuadraticBSpline => f.write_str("quadratic-bspline"),
+            ShapeKind::BSpline(degree) => write!(f, "{}-bspline", degree.word()),
             ShapeKind::DualDomain(DualIntegrals::Particles) => {
                 f.write_str("dual-domain(particles)")
             }
@@ -85,8 +86,13 @@ const ENTRIES: &[Entry<ShapeKind>] = &[
     },
     Entry {
         name: "quadratic_bspline",
-        value: ShapeKind::QuadraticBSpline,
+        value: ShapeKind::BSpline(SplineDegree::Quadratic),
         description: "quadratic B-splines on the open knot vector (BSMPM)",
+    },
+    Entry {
+        name: "cubic_bspline",
+        value: ShapeKind::BSpline(SplineDegree::Cubic),
+        description: "cubic B-splines on the open knot vector",
     },
     Entry {
         name: "dual_domain",
@@ -119,7 +125,7 @@ impl ShapeKind {
     /// basis's at the grid nodes.
     pub fn dofs(&self) -> Dofs {
         match self {
-            ShapeKind::QuadraticBSpline => Dofs::QuadraticSpline,
+            ShapeKind::BSpline(degree) => degree.dofs(),
             ShapeKind::Linear
             | ShapeKind::Domain(_)
             | ShapeKind::DualDomain(_)

@@ -13,7 +13,7 @@ use nalgebra::SVector;
 
 use crate::grid::Grid;
 
-pub use bspline::QuadraticBSpline;
+pub use bspline::{BSpline, SplineDegree};
 pub use domain::{DomainShape, ParticleDomains};
 pub use dual_domain::{DualDomain, DualIntegrals};
 pub use kind::{LmeSettings, ShapeKind, LME_UNSET, SHAPES, SHAPE_NAMES};

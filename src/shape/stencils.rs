@@ -244,7 +244,7 @@ impl<const D: usize> Stencils<D> {
 /// Asserts that the gradients `shape` gives at `x` agree with central differences of its
 /// values within `tolerance`; `x` must be away from cell faces, where values have kinks.
 #[cfg(test)]
-pub(crate) fn assert_gradient_matches_differences<S: Shape<D>, const D: usize>(
+pub(crate) fn assert_gradient_matches_differences<S: Shape<D> + ?Sized, const D: usize>(
     shape: &S,
     grid: &Grid<D>,
     x: &SVector<f64, D>,

@@ -13,9 +13,7 @@ use crate::methods::{self, Method};
 use crate::params::get_usize;
 use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe, TransferKind};
 use crate::run_spec::RunSpec;
-use crate::shape::{
-    DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape, ShapeKind,
-};
+use crate::shape::{DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, Shape, ShapeKind};
 
 /// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
 /// growing dataset).
@@ -27,7 +25,7 @@ const UNSTEPPED_BYTES_PER_POINT: f64 = 512.0;
 /// The estimated peak memory of `spec` in bytes.
 pub fn estimated_bytes(spec: &RunSpec) -> f64 {
     let info = benchmarks::CATALOG.find(&spec.benchmark);
-    let dim = info.map_or(1, |b| b.dim) as i32;
+    let dim = info.map_or(1, |b| b.dim()) as i32;
     let int = |key: &str| get_usize(&spec.params, key).unwrap_or(1) as f64;
     let unstepped = info.is_none_or(|b| b.kind != BenchmarkKind::Simulation);
     let body_particles = (int("cells") * int("ppc")).powi(dim);
@@ -107,7 +105,7 @@ pub fn stencil_nodes<const D: usize>(shape: ShapeKind) -> usize {
     match shape {
         ShapeKind::Linear => Shape::<D>::nodes_per_point(&LinearHat),
         ShapeKind::Domain(_) => ParticleDomains::<D>::nodes_per_point(),
-        ShapeKind::QuadraticBSpline => Shape::<D>::nodes_per_point(&QuadraticBSpline),
+        ShapeKind::BSpline(degree) => degree.shape::<D>().nodes_per_point(),
         ShapeKind::DualDomain(_) => DualDomain::<D>::stencil_nodes(),
         ShapeKind::LocalMaxEnt(settings) => {
             LocalMaxEnt::<D>::with_tolerance(settings.gamma, settings.tolerance)

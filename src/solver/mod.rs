@@ -26,7 +26,7 @@ use crate::reconstruct::{nodal_forces, FitStats};
 use crate::run_spec::RunSpec;
 use crate::shape::ShapeKind;
 use crate::shape::{
-    DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, QuadraticBSpline, Shape, Stencils,
+    DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, Shape, SplineDegree, Stencils,
 };
 
 pub use footprint::estimated_bytes;
@@ -89,8 +89,8 @@ enum Basis<const D: usize> {
     Hat,
     /// The hat averaged over each particle's domain.
     Domains(ParticleDomains<D>),
-    /// The quadratic B-spline evaluated at x_p.
-    BSpline,
+    /// The B-spline of a degree evaluated at x_p.
+    BSpline(SplineDegree),
     /// The hat with the dual-domain gradient, from the integrals over this step's material.
     DualDomain(DualDomain<D>),
     /// Local maximum-entropy functions evaluated at x_p.
@@ -112,7 +112,7 @@ impl<const D: usize> Basis<D> {
     fn shape(&self) -> &dyn Shape<D> {
         match self {
             Basis::Hat | Basis::Domains(_) => &LinearHat,
-            Basis::BSpline => &QuadraticBSpline,
+            Basis::BSpline(degree) => degree.shape(),
             Basis::DualDomain(dual) => dual,
             Basis::LocalMaxEnt(lme) => lme,
         }
@@ -166,7 +166,7 @@ impl<'a, const D: usize> Run<'a, D> {
         let basis = match method.shape {
             ShapeKind::Linear => Basis::Hat,
             ShapeKind::Domain(shape) => Basis::Domains(ParticleDomains::new(shape, &particles)),
-            ShapeKind::QuadraticBSpline => Basis::BSpline,
+            ShapeKind::BSpline(degree) => Basis::BSpline(degree),
             ShapeKind::DualDomain(integrals) => {
                 Basis::DualDomain(DualDomain::new(&grid, integrals))
             }
@@ -399,9 +399,9 @@ impl<'a, const D: usize> Run<'a, D> {
                 domains.fill(&self.grid, &mut self.particles, &mut self.stencils)?;
                 Ok(())
             }
-            Basis::BSpline => self
+            Basis::BSpline(degree) => self
                 .stencils
-                .update(&QuadraticBSpline, &self.grid, &self.particles.x)
+                .update(degree.shape(), &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
             Basis::DualDomain(dual) => {
                 dual.integrate(
@@ -601,7 +601,7 @@ pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
             .into(),
         dim: benchmarks::CATALOG
             .find(&spec.benchmark)
-            .map_or(0, |b| b.dim),
+            .map_or(0, |b| b.dim()),
         cells: int("cells"),
         ppc: int("ppc"),
         h: f64::NAN,

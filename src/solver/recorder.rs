@@ -338,7 +338,7 @@ fn nan_max(current: f64, value: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::benchmarks::{gong_mms, thesis_params, SineMms};
-    use crate::grid::Dofs;
+    use crate::shape::SplineDegree;
 
     /// Sampled at t = 3.7 ms, when the material has moved by up to 3.3 % of the box, with a
     /// grid velocity that belongs to 4.2 ms.
@@ -394,7 +394,7 @@ mod tests {
         assert_eq!((w[0], w[1], w[6]), (0.25 * h2, 0.5 * h2, h2));
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-15);
         let bar = gong_mms::<1>(&thesis_params(0.05, 4, 2)).unwrap();
-        let spline = Grid::<1>::with_dofs(&bar.domain(), Dofs::QuadraticSpline);
+        let spline = Grid::<1>::with_dofs(&bar.domain(), SplineDegree::Quadratic.dofs());
         let mut recorder = Recorder::<1>::new();
         recorder.attach_grid(&spline);
         let h = spline.h;

@@ -10,7 +10,7 @@ use crate::benchmarks::shape_functions::ShapeProblem;
 use crate::grid::{lattice_coords, Dofs, Grid};
 use crate::output::{RunRecord, RunStatus, ShapeFunctionRecord};
 use crate::run_spec::RunSpec;
-use crate::shape::{LinearHat, LmeFailure, LocalMaxEnt, QuadraticBSpline, Shape};
+use crate::shape::{LinearHat, LmeFailure, LocalMaxEnt, Shape, SplineDegree};
 use crate::shape_methods::{self, Basis};
 
 /// Neighbours of the centre node recorded on each side along x.
@@ -72,7 +72,7 @@ fn prepare(spec: &RunSpec) -> Result<(Basis, ShapeProblem), String> {
 enum Evaluator<const D: usize> {
     Lme(LocalMaxEnt<D>),
     Hat,
-    BSpline,
+    BSpline(SplineDegree),
 }
 
 impl<const D: usize> Evaluator<D> {
@@ -80,13 +80,13 @@ impl<const D: usize> Evaluator<D> {
         Ok(match basis {
             Basis::Lme => Evaluator::Lme(problem.lme().map_err(|e| e.to_string())?),
             Basis::Linear => Evaluator::Hat,
-            Basis::QuadraticBSpline => Evaluator::BSpline,
+            Basis::BSpline(degree) => Evaluator::BSpline(degree),
         })
     }
 
     fn dofs(&self) -> Dofs {
         match self {
-            Evaluator::BSpline => Dofs::QuadraticSpline,
+            Evaluator::BSpline(degree) => degree.dofs(),
             _ => Dofs::Nodes,
         }
     }
@@ -95,7 +95,7 @@ impl<const D: usize> Evaluator<D> {
         match self {
             Evaluator::Lme(lme) => lme,
             Evaluator::Hat => &LinearHat,
-            Evaluator::BSpline => &QuadraticBSpline,
+            Evaluator::BSpline(degree) => degree.shape(),
         }
     }
 
@@ -236,7 +236,7 @@ mod tests {
         let grid = Grid::new(&domain);
         // Node (3, 3) of a 7 x 7 lattice is 24.
         assert_eq!(recorded_nodes(&grid), [22, 23, 24, 25, 26]);
-        let spline = Grid::with_dofs(&domain, Dofs::QuadraticSpline);
+        let spline = Grid::with_dofs(&domain, SplineDegree::Quadratic.dofs());
         // DOF (3, 3) of 8 x 8 sits at (2.5, 2.5), the first of the two nearest the middle.
         assert_eq!(recorded_nodes(&spline), [25, 26, 27, 28, 29]);
         let small = Grid::<1>::new(&Domain {

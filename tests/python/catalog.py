@@ -28,7 +28,13 @@ BENCHMARK_KINDS = {b["name"]: b["kind"] for b in BENCHMARK_LIST}
 # The parts whose mappings conserve mass and momentum to round-off: shape functions that are a
 # partition of unity to the last bit, with the lumped Shepard sums, the consistent mass matrix
 # or TLS, which prescribes each element's mass and momentum.
-CONSERVING_SHAPES = ("linear", "quadratic_bspline", "dual_domain", "dual_domain_cells")
+CONSERVING_SHAPES = (
+    "linear",
+    "quadratic_bspline",
+    "cubic_bspline",
+    "dual_domain",
+    "dual_domain_cells",
+)
 CONSERVING_TRANSFERS = ("shepard", "consistent_mass", "tls", "tls_lumped")
 
 

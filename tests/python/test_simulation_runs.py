@@ -263,10 +263,15 @@ def _axis_coordinates(x, d, per_axis):
     return [x[[i * strides[k] for i in range(per_axis)], k] for k in range(d)]
 
 
+# The root attribute `shape` of the B-spline runs and the degree it names.
+SPLINE_DEGREES = {"quadratic-bspline": 2, "cubic-bspline": 3}
+
+
 def test_grid_dofs_and_weights(run):
-    """/grid/x is the lattice of the basis' DOFs (the nodes, or the quadratic B-spline's
-    Greville abscissae 0, h/2, 3h/2, ..., L - h/2, L), first axis fastest, and /grid/weight the
-    trapezoidal rule over it, which sums to the volume of the grid."""
+    """/grid/x is the lattice of the basis' DOFs (the nodes, or a B-spline's Greville
+    abscissae, the means of its interior knots: 0, h/2, 3h/2, ..., L - h/2, L for the quadratic),
+    first axis fastest, and /grid/weight the trapezoidal rule over it, which sums to the volume
+    of the grid."""
     run.require_data()
     a = run.attrs
     x = run.ds("/grid/x")
@@ -276,17 +281,18 @@ def test_grid_dofs_and_weights(run):
         assert x.shape[0] == 0, "a reference solver has no grid"
         return
     d, h = int(a["dim"]), float(a["h"])
-    spline = str(a["shape"]) == "quadratic-bspline"
+    # The hat and the bases built on it have a DOF per node, a B-spline of degree p cells + p.
+    degree = SPLINE_DEGREES.get(str(a["shape"]), 1)
     # The grid may reach beyond the body (empty cells for it to move into), so its cells are
     # read from the lattice, not from the `cells` parameter.
     per_axis = int(round(x.shape[0] ** (1.0 / d)))
     assert x.shape[0] == per_axis**d, f"{x.shape[0]} DOFs are not a {d}-dimensional lattice"
-    cells = per_axis - (2 if spline else 1)
+    cells = per_axis - degree
     assert cells >= int(a["cells"]), f"{cells} grid cells for a body of {a['cells']}"
     lower = x[0]
-    steps = np.concatenate(([0.0], np.arange(per_axis - 2) + 0.5, [cells])) if spline else (
-        np.arange(per_axis, dtype=float)
-    )
+    # Knots t_j = clamp(j - p, 0, cells); DOF i at the mean of t_(i+1), ..., t_(i+p).
+    knots = np.clip(np.arange(per_axis + degree + 1) - degree, 0, cells)
+    steps = np.array([knots[i + 1:i + degree + 1].mean() for i in range(per_axis)])
     axes = _axis_coordinates(x, d, per_axis)
     for k in range(d):
         np.testing.assert_allclose(

@@ -6,9 +6,9 @@ use nalgebra::SVector;
 
 use super::functions::{ElementFunction, SurfaceFunction, TestFunction};
 use super::points::{cell_fractions, check_ppc, Spacing};
-use super::BenchmarkKind;
 use super::ParamSpec;
 use super::{choice, interval, BenchmarkInfo, Domain, ParamDefault, ParamKind};
+use super::{BenchmarkKind, Build};
 use crate::benchmarks::limits::{check_count, largest, per_axis_total, power};
 use crate::grid::lattice_coords;
 use crate::params::{get_usize, ParamError, Params};
@@ -81,7 +81,7 @@ pub const INFO: BenchmarkInfo = BenchmarkInfo {
     name: "recon_tls",
     kind: BenchmarkKind::Elementwise,
     // Runs take the dimension of their function; this is the largest.
-    dim: 2,
+    build: Build::Points { dim: 2 },
     source: "Wobbes et al. 2018, sec 2.1, Figs 1-2",
     description: "u sampled element by element (1D or 2D), reconstructed on each element, \
                   RMS and integral errors at Gauss points",

@@ -19,7 +19,7 @@ pub use points::{place, Spacing};
 use points::check_ppc;
 
 use super::limits::{check_count, check_lattice};
-use super::{BenchmarkInfo, BenchmarkKind, ParamDefault, ParamKind, ParamSpec};
+use super::{BenchmarkInfo, BenchmarkKind, Build, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
 use crate::params::{get_f64, get_list, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{Weight, MAX_NODE_SUPPORT_CELLS};
@@ -124,7 +124,7 @@ const BASIS_PARAMS: &[ParamSpec] = &[
 pub const INFO_NODES: BenchmarkInfo = BenchmarkInfo {
     name: "recon1d_nodes",
     kind: BenchmarkKind::Reconstruction,
-    dim: 1,
+    build: Build::Points { dim: 1 },
     source: "Gong 2015, sec 4.3.1 and 5.2",
     description: "u sampled at equal or random points per cell, reconstructed at the grid nodes",
     params: NODE_PARAMS,
@@ -135,7 +135,7 @@ pub const INFO_NODES: BenchmarkInfo = BenchmarkInfo {
 pub const INFO_BASIS: BenchmarkInfo = BenchmarkInfo {
     name: "recon1d_basis",
     kind: BenchmarkKind::OrthogonalBasis,
-    dim: 1,
+    build: Build::Points { dim: 1 },
     source: "Tran et al. 2019, eq 16, Figs 1-3",
     description: "weighted orthogonal polynomials of given points, and u reconstructed from them",
     params: BASIS_PARAMS,
