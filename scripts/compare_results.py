@@ -5,8 +5,8 @@
 For every experiment directory of A (one with an experiment.yaml) B must have the same
 experiment.yaml, the same run files and no temporary files left, and every pair of run files
 must hold the same groups, datasets and attributes: every dataset with the same dtype, shape
-and bytes, every attribute equal. Excluded, because it records time: the root attribute
-`wall_seconds` of each run file (and timings.csv and costs.md, which are not compared). B must have the same
+and bytes, every attribute equal. Excluded, because they record time: the root attributes
+`wall_seconds` and `step_seconds` of each run file (and timings.csv and costs.md, which are not compared). B must have the same
 XDMF descriptions (<run_id>.xdmf), byte for byte. The report files
 (summary.csv, rates.csv, report.md, figures/*.png) must be byte-identical where A has them.
 Exits 1 listing the differences.
@@ -18,7 +18,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-TIME_ATTRS = {("/", "wall_seconds")}
+TIME_ATTRS = {("/", "wall_seconds"), ("/", "step_seconds")}
 
 
 def value_bytes(value):
@@ -117,7 +117,8 @@ def main(argv):
     print(
         f"{len(experiments)} experiments, {counts['runs']} run files: {counts['datasets']} "
         f"datasets and {counts['attributes']} attributes compared bit for bit (excluded: the "
-        f"root attribute wall_seconds), {counts['descriptions']} XDMF descriptions and "
+        f"root attributes wall_seconds and step_seconds), {counts['descriptions']} XDMF "
+        f"descriptions and "
         f"{counts['report files']} report files byte for byte: "
         + ("identical" if not problems else f"{len(problems)} differences")
     )

@@ -60,6 +60,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         status: RunStatus::Ok,
         message: String::new(),
         wall_seconds: 0.01 * cells as f64,
+        step_seconds: 1e-4 * cells as f64,
         axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
         final_norms,
         reconstruction: None,

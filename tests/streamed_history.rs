@@ -48,7 +48,7 @@ fn contents(group: &Group, prefix: &str, out: &mut Vec<(String, Stored)>) {
     let mut names = group.attr_names().unwrap();
     names.sort();
     for name in names {
-        if name != "wall_seconds" {
+        if name != "wall_seconds" && name != "step_seconds" {
             let attr = group.attr(&name).unwrap();
             out.push((format!("{prefix}@{name}"), read_attr(&attr)));
         }

@@ -22,10 +22,11 @@ matrix:
 output: {every: 10}
 ";
 
-/// The record with its wall time cleared, as text: `Debug` prints every float so that it
+/// The record with its wall and step times cleared, as text: `Debug` prints every float so that it
 /// reads back to the same bits, so equal texts are bitwise-equal records.
 fn record_text(mut record: RunRecord) -> String {
     record.wall_seconds = 0.0;
+    record.step_seconds = 0.0;
     format!("{record:?}")
 }
 

@@ -187,6 +187,8 @@ pub struct RunSummary {
     pub status: RunStatus,
     pub message: String,
     pub wall_seconds: f64,
+    /// The median wall time of one step (NaN without a time loop, or from a file that lacks it).
+    pub step_seconds: f64,
     /// The run's value of each matrix axis (from the `/matrix` group).
     pub axes: Params,
     /// Final error norms keyed by (field, norm), e.g. ("velocity", "l2").

@@ -168,6 +168,12 @@ fn summary(file: &hdf5::File) -> hdf5::Result<RunSummary> {
         status,
         message: read_str(file, "message")?,
         wall_seconds: read_f64(file, "wall_seconds")?,
+        // Files written before the attribute existed have no step time, nothing else missing.
+        step_seconds: if file.attr_names()?.iter().any(|n| n == "step_seconds") {
+            read_f64(file, "step_seconds")?
+        } else {
+            f64::NAN
+        },
         axes: read_params(&matrix)?,
         final_norms,
         reconstruction,

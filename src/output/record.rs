@@ -21,6 +21,8 @@ pub struct RunRecord {
     pub status: RunStatus,
     pub message: String,
     pub wall_seconds: f64,
+    /// The median wall time of one step of the time loop; NaN for runs without one.
+    pub step_seconds: f64,
     pub particles: ParticleTable,
     pub history: History,
     pub grid: GridHistory,

@@ -152,7 +152,11 @@ fn write_identity(file: &hdf5::File, r: &RunRecord) -> hdf5::Result<()> {
     for (name, value) in [("dim", r.dim), ("cells", r.cells), ("ppc", r.ppc)] {
         attr_i64(file, name, value as i64)?;
     }
-    for (name, value) in [("h", r.h), ("wall_seconds", r.wall_seconds)] {
+    for (name, value) in [
+        ("h", r.h),
+        ("wall_seconds", r.wall_seconds),
+        ("step_seconds", r.step_seconds),
+    ] {
         attr_f64(file, name, value)?;
     }
     for (name, values) in [("params", &r.spec.params), ("matrix", &r.spec.axes)] {

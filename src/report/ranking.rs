@@ -1,7 +1,7 @@
 //! The runs of an experiment ranked, for comparisons of whole methods such as the component
 //! matrix (every valid shape x transfer x integrator): by their final error in one field and
-//! norm into report.md, and by their wall time into costs.md, which like timings.csv changes
-//! with every rerun and machine and so stays out of the committed results.
+//! norm into report.md, and by the time their steps take into costs.md, which like timings.csv
+//! changes with every rerun and machine and so stays out of the committed results.
 
 use std::cmp::Ordering;
 use std::fmt::Write;
@@ -88,8 +88,9 @@ pub fn by_error<'a>(
         note: format!(
             "The {} runs that finished, from the smallest {norm} {field} error over the \
              particles at the final time to the largest, then the {} that did not (status), \
-             unranked. The ranking by cost, from the wall times, is in costs.md beside this \
-             report: it changes with every rerun, so it is not part of the committed results.",
+             unranked. The ranking by cost, from the measured step times, is in costs.md beside \
+             this report: it changes with every rerun, so it is not part of the committed \
+             results.",
             finished,
             ranked.len() - finished
         ),
@@ -98,9 +99,15 @@ pub fn by_error<'a>(
     })
 }
 
-/// costs.md: for each `ranking` entry, its runs from the shortest wall time to the longest
-/// (finished runs only; those that stopped early are listed after them), with the time over
-/// the shortest and the run's rank by error. `None` when the experiment ranks nothing.
+/// The time a run's steps take: the median step times the steps, so that neither the set-up
+/// nor a step slowed by writing a sample or by another process counts.
+fn stepping_seconds(run: &RunSummary) -> f64 {
+    run.step_seconds * run.steps as f64
+}
+
+/// costs.md: for each `ranking` entry, its finished runs from the shortest stepping time to
+/// the longest, then those that stopped early or do not step, with the time over the shortest,
+/// the whole wall time and the run's rank by error. `None` when the experiment ranks nothing.
 pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> {
     let specs: Vec<&TableSpec> = experiment
         .tables
@@ -111,9 +118,12 @@ pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> 
         return None;
     }
     let mut md = format!(
-        "# {}: ranking by cost\n\nWall time of each run as `mpmlab run` measured it (the \
-         `wall_seconds` of its file; concurrent runs share the machine, so compare orders of \
-         magnitude, not percent). Rewritten by every `mpmlab report`; not committed.\n\n",
+        "# {}: ranking by cost\n\nThe time each run's steps took as `mpmlab run` measured it: \
+         the median wall time of a step (`step_seconds` in its file) times its steps, which \
+         leaves out the set-up and the occasional slow step (a sample written, another \
+         process); `wall s` is the whole run (`wall_seconds`). Runs that share the machine \
+         (`--jobs`) slow each other, so compare factors, not percent. Rewritten by every \
+         `mpmlab report`; not committed.\n\n",
         experiment.name
     );
     for spec in specs {
@@ -123,13 +133,18 @@ pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> 
         let selected = ordered_runs(runs.iter().filter(|run| selects(&spec.select, &run.axes)));
         let error_rank = rank(&selected, |run| ranked_error(run, field, norm));
         let by_time = rank(&selected, |run| {
-            (run.status == RunStatus::Ok).then_some(run.wall_seconds)
+            let seconds = stepping_seconds(run);
+            (run.status == RunStatus::Ok && seconds.is_finite()).then_some(seconds)
         });
-        let fastest = by_time.first().map(|(_, run)| run.wall_seconds);
+        let fastest = by_time
+            .first()
+            .map(|(_, run)| stepping_seconds(run))
+            .filter(|s| s.is_finite());
         let in_order: Vec<&RunSummary> = by_time.iter().map(|(_, run)| *run).collect();
         let columns = [
-            "wall s".to_string(),
+            "steps s".to_string(),
             "/ shortest".to_string(),
+            "wall s".to_string(),
             format!("rank by {norm} {field} error"),
         ];
         let (mut header, rows) = per_run_rows(experiment, &in_order, columns, |run| {
@@ -137,16 +152,18 @@ pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> 
                 .iter()
                 .find(|(_, r)| r.run_id == run.run_id)
                 .and_then(|(rank, _)| *rank);
+            let seconds = stepping_seconds(run);
             vec![
+                general(seconds, 3),
+                fastest.map_or_else(String::new, |f| general(seconds / f, 3)),
                 general(run.wall_seconds, 3),
-                fastest.map_or_else(String::new, |f| general(run.wall_seconds / f, 3)),
                 rank_text(error_rank),
             ]
         });
         header.insert(0, "rank".to_string());
         let _ = writeln!(
             md,
-            "## Ranking by wall time{}\n",
+            "## Ranking by stepping time{}\n",
             title_suffix(&label(&spec.select))
         );
         let rows = by_time.iter().zip(rows).map(|((r, _), mut row)| {

@@ -277,6 +277,7 @@ mod tests {
             status,
             message: String::new(),
             wall_seconds: 0.0,
+            step_seconds: f64::NAN,
             axes: Params::from([("cfl".to_string(), ParamValue::Float(cfl))]),
             final_norms: BTreeMap::new(),
             reconstruction: None,

@@ -142,6 +142,8 @@ struct Run<'a, const D: usize> {
     cells: Vec<usize>,
     grid_crossings: usize,
     recorder: Recorder<D>,
+    /// The wall time of each completed step, for `RunRecord::step_seconds`.
+    step_seconds: Vec<f64>,
 }
 
 impl<'a, const D: usize> Run<'a, D> {
@@ -198,6 +200,7 @@ impl<'a, const D: usize> Run<'a, D> {
             cells: Vec::new(),
             grid_crossings: 0,
             recorder,
+            step_seconds: Vec::new(),
             problem,
         }
     }
@@ -226,6 +229,7 @@ impl<'a, const D: usize> Run<'a, D> {
                 },
             },
         );
+        record.step_seconds = median(&mut self.step_seconds);
         // The file counts them; the message makes them visible in summary.csv and report.md.
         let failures = record.diagnostics.lme_failures;
         if failures > 0 {
@@ -255,6 +259,7 @@ impl<'a, const D: usize> Run<'a, D> {
             return (0, Err((0, reason)));
         }
         for s in 0..=steps {
+            let started = Instant::now();
             let t = s as f64 * dt;
             self.problem.body_force(t, &mut self.body_force);
             // Staggered velocities start with a half kick from v^0 to v^{1/2}.
@@ -317,6 +322,7 @@ impl<'a, const D: usize> Run<'a, D> {
             {
                 return (s, Err((s + 1, reason)));
             }
+            self.step_seconds.push(started.elapsed().as_secs_f64());
         }
         (steps, Ok(()))
     }
@@ -519,6 +525,21 @@ fn synchronising_half(s: usize, dt: f64) -> f64 {
 }
 
 /// The end of a stepped run (MPM or a reference solver), whatever method made it.
+/// The median of `times` (NaN for none): a step's cost, which the samples written to the file
+/// and the other processes of the machine disturb only now and then.
+fn median(times: &mut [f64]) -> f64 {
+    if times.is_empty() {
+        return f64::NAN;
+    }
+    times.sort_by(f64::total_cmp);
+    let mid = times.len() / 2;
+    if times.len() % 2 == 1 {
+        times[mid]
+    } else {
+        0.5 * (times[mid - 1] + times[mid])
+    }
+}
+
 struct Stepped<const D: usize> {
     parts: MethodParts,
     h: f64,
@@ -611,6 +632,7 @@ pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         status: RunStatus::Failed,
         message,
         wall_seconds: 0.0,
+        step_seconds: f64::NAN,
         particles: ParticleTable::default(),
         history: Default::default(),
         grid: Default::default(),

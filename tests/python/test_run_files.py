@@ -42,7 +42,7 @@ Without the variable, or with no *.h5 file under it, the suite fails (it never p
 import numpy as np
 import pytest
 
-from catalog import BENCHMARK_KINDS
+from catalog import BENCHMARK_KINDS, REFERENCE_METHODS
 from layout import (
     ENV, FLOAT_ATTRS, INT_ATTRS, RTOL_STORED, RUN_FILES, RUN_ID, SCHEMA_VERSION,
     SIMULATION_FLOAT_ATTRS, SIMULATION_INT_ATTRS, SIMULATION_STR_ATTRS, STATUSES, STR_ATTRS,
@@ -119,6 +119,13 @@ def test_root_attributes(run):
         assert a[name].strip(), f"{name} is empty"
     assert a["dim"] in (1, 2, 3)
     assert a["cells"] >= 1 and a["h"] > 0 and a["wall_seconds"] >= 0
+    # The median step time: of the MPM time loop only, and only when it completed a step.
+    assert "step_seconds" in a
+    stepped = not run.is_unstepped and a["method"] not in REFERENCE_METHODS and a["steps"] > 0
+    if stepped:
+        assert 0 < a["step_seconds"] <= a["wall_seconds"]
+    elif run.is_unstepped or a["method"] in REFERENCE_METHODS:
+        assert np.isnan(a["step_seconds"])
     if run.is_reconstruction:
         # ppc is 0 when the points are given in the experiment file (recon1d_basis).
         assert a["dim"] == 1 and a["ppc"] >= 0
