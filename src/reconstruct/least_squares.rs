@@ -12,7 +12,7 @@ use num_traits::Zero;
 use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
-use super::solve::{mls_coefficients, Moments, OrthogonalBasis};
+use super::solve::{mls_coefficients, Moments, Orthogonal};
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -277,22 +277,23 @@ impl<const D: usize> Reconstructor<D> {
                 continue;
             }
             stats.fits += 1;
-            let solved = match self.recipe.solver {
+            match self.recipe.solver {
                 Solver::Mls => {
-                    mls_coefficients(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
-                        point: e,
-                        position: self.lattice.point(e).iter().copied().collect(),
-                    })?
+                    let solved =
+                        mls_coefficients(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
+                            point: e,
+                            position: self.lattice.point(e).iter().copied().collect(),
+                        })?;
+                    c.copy_from_slice(&solved[..T]);
                 }
                 Solver::Imls => {
-                    let basis = OrthogonalBasis::from_rows(a, MAX_TERMS, T);
+                    let basis = Orthogonal::<T>::from_rows(a, MAX_TERMS, T);
                     if basis.rank() < T {
                         stats.rank_deficient += 1;
                     }
-                    basis.shape_coefficients::<T>()
+                    c.copy_from_slice(&basis.shape_coefficients::<T>());
                 }
-            };
-            c.copy_from_slice(&solved[..T]);
+            }
         }
         Ok(stats)
     }

@@ -50,34 +50,51 @@ pub(super) fn add_weighted_outer(a: &mut [f64], stride: usize, w: f64, q: &[f64]
 
 /// The weighted orthogonal polynomials p_i = sum_j coeffs[i][j] q_j of Tran eq 16, built
 /// from the inner products <q_i, q_j> = A_ij (eq 7).
-#[derive(Clone, Debug, Default)]
-pub struct OrthogonalBasis {
+/// Sized for up to `S` terms: `MAX_TERMS` where the basis size is known only at run time
+/// (`OrthogonalBasis`), the size itself where it is a constant, which spares a per-point solve
+/// the clearing of arrays for terms it does not have.
+#[derive(Clone, Debug)]
+pub struct Orthogonal<const S: usize> {
     pub terms: usize,
     /// Unit lower-triangular: p_i = q_i - sum_{k<i} (<q_i, p_k>/<p_k, p_k>) p_k.
-    pub coeffs: [[f64; MAX_TERMS]; MAX_TERMS],
+    pub coeffs: [[f64; S]; S],
     /// <p_i, p_i>.
-    pub norms: [f64; MAX_TERMS],
+    pub norms: [f64; S],
     /// Whether p_i is supported by the data (else it is left out of every sum).
-    pub kept: [bool; MAX_TERMS],
+    pub kept: [bool; S],
+}
+
+pub type OrthogonalBasis = Orthogonal<MAX_TERMS>;
+
+impl<const S: usize> Default for Orthogonal<S> {
+    fn default() -> Self {
+        Orthogonal {
+            terms: 0,
+            coeffs: [[0.0; S]; S],
+            norms: [0.0; S],
+            kept: [false; S],
+        }
+    }
 }
 
 impl OrthogonalBasis {
     pub fn from_moments(a: &Moments, terms: usize) -> Self {
         Self::from_rows(a, MAX_TERMS, terms)
     }
+}
 
+impl<const S: usize> Orthogonal<S> {
     /// `from_moments` of a row-major matrix with row length `stride`. Always inlined so that
     /// callers with a fixed basis size get the loops unrolled.
     #[inline(always)]
     pub(super) fn from_rows(a: &[f64], stride: usize, terms: usize) -> Self {
-        let mut basis = OrthogonalBasis {
+        debug_assert!(terms <= S);
+        let mut basis = Orthogonal {
             terms,
-            coeffs: [[0.0; MAX_TERMS]; MAX_TERMS],
-            norms: [0.0; MAX_TERMS],
-            kept: [false; MAX_TERMS],
+            ..Self::default()
         };
         for i in 0..terms {
-            let mut c = [0.0; MAX_TERMS];
+            let mut c = [0.0; S];
             c[i] = 1.0;
             for k in 0..i {
                 if !basis.kept[k] {
@@ -111,8 +128,8 @@ impl OrthogonalBasis {
     /// p_i(x) = coeffs[i][0] because the monomials vanish at the evaluation point. `N` is
     /// the basis size, `terms`.
     #[inline]
-    pub fn shape_coefficients<const N: usize>(&self) -> [f64; MAX_TERMS] {
-        let mut first = [0.0; MAX_TERMS];
+    pub fn shape_coefficients<const N: usize>(&self) -> [f64; S] {
+        let mut first = [0.0; S];
         first[0] = 1.0;
         self.solve::<f64, N>(&first)
     }
@@ -123,9 +140,9 @@ impl OrthogonalBasis {
     /// several fields at once (`Fitted`), each solved with a scalar's arithmetic. `N` is the
     /// basis size, `terms`, as a constant so that the loops unroll.
     #[inline]
-    pub fn solve<T: Fitted, const N: usize>(&self, rhs: &[T; MAX_TERMS]) -> [T; MAX_TERMS] {
+    pub fn solve<T: Fitted, const N: usize>(&self, rhs: &[T; S]) -> [T; S] {
         debug_assert_eq!(N, self.terms);
-        let mut out = [T::splat(0.0); MAX_TERMS];
+        let mut out = [T::splat(0.0); S];
         for i in 0..N {
             if !self.kept[i] {
                 continue;
@@ -170,7 +187,7 @@ impl<const R: usize, const C: usize> Fitted for SMatrix<f64, R, C> {
 
 /// c^T A c over the leading `n` entries, A row-major with row length `stride`.
 #[inline(always)]
-fn quadratic_form(a: &[f64], stride: usize, c: &[f64; MAX_TERMS], n: usize) -> f64 {
+fn quadratic_form<const S: usize>(a: &[f64], stride: usize, c: &[f64; S], n: usize) -> f64 {
     let mut sum = 0.0;
     for i in 0..n {
         let row: f64 = (0..n).map(|j| a[i * stride + j] * c[j]).sum();
