@@ -15,6 +15,7 @@ use nalgebra::SVector;
 
 use mpmlab::benchmarks::{self, thesis_params};
 
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::grid::{Domain, Grid};
 use mpmlab::integrate::INTEGRATOR_NAMES;
 use mpmlab::methods::{self, GAMMA_KEY, INTEGRATOR_KEY};
@@ -184,10 +185,10 @@ fn variants(filter: Option<&str>) -> Vec<Variant> {
     variants
 }
 
-fn spec(case: &Case, variant: &Variant) -> RunSpec {
+fn spec(case: &Case, variant: &Variant) -> ResolvedRun {
     let mut params = (case.params)();
     params.extend(variant.method_params.clone());
-    RunSpec {
+    let spec = RunSpec {
         experiment: "bench".into(),
         run_id: "bench".into(),
         benchmark: case.benchmark.into(),
@@ -196,7 +197,8 @@ fn spec(case: &Case, variant: &Variant) -> RunSpec {
         axes: Params::new(),
         output_every: 0,
         config_yaml: String::new(),
-    }
+    };
+    ResolvedRun::resolve(spec).expect("the bench cases are valid runs")
 }
 
 /// Microseconds per point of `shape` at `points` random points of a 32-cell grid, best of
@@ -260,8 +262,8 @@ fn lme_evaluation_costs() {
 /// and with a `reference` the best wall time of that over as many runs, each right after one
 /// of `spec`'s, so that a change in the machine's speed reaches both times of the ratio.
 fn timed(
-    spec: &RunSpec,
-    reference: Option<&RunSpec>,
+    spec: &ResolvedRun,
+    reference: Option<&ResolvedRun>,
 ) -> (f64, f64, usize, mpmlab::output::RunRecord) {
     let mut best = f64::INFINITY;
     let mut best_reference = f64::INFINITY;

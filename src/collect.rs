@@ -43,7 +43,7 @@ pub fn collect(dir: &Path) -> Result<Collected, String> {
     let mut runs = Vec::new();
     let mut missing = Vec::new();
     let mut unreadable = Vec::new();
-    for spec in &experiment.runs {
+    for spec in experiment.runs.iter().map(|run| &run.spec) {
         let path = run_path(dir, &spec.run_id);
         if !path.exists() {
             missing.push(spec.run_id.clone());
@@ -110,7 +110,11 @@ fn foreign_files(dir: &Path, experiment: &Experiment) -> Result<Vec<UnreadableRu
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(format!("{}: {e}", runs.display())),
     };
-    let matrix: BTreeSet<&str> = experiment.runs.iter().map(|r| r.run_id.as_str()).collect();
+    let matrix: BTreeSet<&str> = experiment
+        .runs
+        .iter()
+        .map(|r| r.spec.run_id.as_str())
+        .collect();
     let mut paths: Vec<PathBuf> = entries
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|path| {

@@ -8,6 +8,7 @@ use serde_json::{json, Value};
 use mpmlab::catalog::Parts;
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
+use mpmlab::grid::Dofs;
 use mpmlab::output::{remove_dead_temps, write_atomically};
 use mpmlab::runner::{
     check_copy, check_distinct_names, parse_size, results_dir, run_experiment, RunOptions,
@@ -217,9 +218,9 @@ fn expand(file: &Path, json: bool) -> Result<(), String> {
     let experiment = experiment::load(file).map_err(|e| e.to_string())?;
     for run in &experiment.runs {
         if json {
-            println!("{}", run.to_json());
+            println!("{}", run.spec.to_json());
         } else {
-            println!("{}", run.describe());
+            println!("{}", run.spec.describe());
         }
     }
     Ok(())
@@ -478,6 +479,24 @@ fn parts_json<T>(parts: &Parts<T>) -> Value {
         .collect()
 }
 
+/// The shape parts, each with the degree of its DOF lattice: cells + `dof_degree` DOFs per
+/// axis at the Greville abscissae of that degree (1: the grid nodes).
+fn shapes_json() -> Value {
+    let mut shapes = parts_json(&shape::SHAPES);
+    for (json, entry) in shapes
+        .as_array_mut()
+        .into_iter()
+        .flatten()
+        .zip(shape::SHAPES.entries)
+    {
+        json["dof_degree"] = json!(match entry.value.dofs() {
+            Dofs::Nodes => 1,
+            Dofs::BSpline { degree } => degree,
+        });
+    }
+    shapes
+}
+
 /// Everything `list_methods` prints, for tools.
 fn methods_json() -> Value {
     let presets: Vec<Value> = methods::PRESETS
@@ -499,7 +518,7 @@ fn methods_json() -> Value {
     json!({
         "presets": presets,
         "parts": {
-            "shape": parts_json(&shape::SHAPES),
+            "shape": shapes_json(),
             "transfer": parts_json(&reconstruct::TRANSFERS),
             "integrator": parts_json(&integrate::INTEGRATORS),
         },

@@ -9,7 +9,7 @@ use crate::benchmarks::{ParamDefault, ParamKind, ParamSpec};
 use crate::catalog::{names_of, Catalog, Entry, Named, Parts};
 use crate::grid::Dofs;
 use crate::integrate::{IntegratorKind, INTEGRATORS, INTEGRATOR_NAMES};
-use crate::params::{get_f64, get_str, get_usize, ParamError, ParamValue, Params};
+use crate::params::{get_f64, get_str, get_usize, ParamError, Params};
 use crate::reconstruct::{
     TransferKind, BODY_FORCE_FITS, BODY_FORCE_FIT_NAMES, IMLS, IMLS_CPLS, IMLS_EQ27, IMPM,
     IMPM_FIELDS, IMPM_VELOCITY, TLS, TLS_LUMPED, TRANSFERS, TRANSFER_NAMES,
@@ -573,15 +573,6 @@ fn named_part<T: Copy>(
     Ok(Some(entry.value))
 }
 
-/// The shape function of a run of `method` with `params`: the run's `shape` where it names a
-/// known one, the preset's otherwise.
-pub fn run_shape(method: &str, params: &Params) -> Option<ShapeKind> {
-    match params.get(SHAPE_KEY) {
-        Some(ParamValue::Str(name)) => SHAPES.find(name).map(|e| e.value),
-        _ => PRESETS.find(method).map(|p| p.method.shape),
-    }
-}
-
 /// The run's `sampled_velocity`, which only the whole-step schemes MUSL and USL have a choice of.
 fn sampled_velocity(
     preset: &MethodPreset,
@@ -773,6 +764,7 @@ impl fmt::Display for Method {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::ParamValue;
 
     fn params(entries: &[(&str, ParamValue)]) -> Params {
         let mut p: Params = [("cells".to_string(), ParamValue::Int(8))].into();

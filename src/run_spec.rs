@@ -1,9 +1,10 @@
-//! One run of an experiment, fully resolved: what `experiment` expands a file into and every
-//! later stage (runner, solver, output) is handed.
+//! One run of an experiment as its file states it, defaults filled in: the names and values
+//! a run record carries into its HDF5 file. `experiment::ResolvedRun` holds it beside what
+//! the names stand for.
 
 use crate::params::Params;
 
-/// Everything one run needs, fully resolved.
+/// One run's benchmark, method, parameters and identity.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunSpec {
     pub experiment: String,

@@ -15,16 +15,14 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-use crate::benchmarks::AnyProblem;
 use crate::experiment::Experiment;
+use crate::experiment::ResolvedRun;
 use crate::output::{
     compute_run, describe_if_missing, read_message, remove_dead_temps, run_path, write_atomically,
     write_run, RunRecord, RunStatus,
 };
 use crate::parallel::with_threads;
-use crate::params::get_usize;
-use crate::run_spec::RunSpec;
-use crate::solver::{base_record, estimated_bytes, simulate_into};
+use crate::solver::{base_record, Job};
 
 pub use memory::{parse_size, MemoryBudget, REFUSED};
 
@@ -70,7 +68,7 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
     remove_dead_temps(&dir)?;
     locks::remove_leftovers(&dir)?;
     let mut outcome = MatrixOutcome::default();
-    let mut runs: Vec<&RunSpec> = experiment.runs.iter().collect();
+    let mut runs: Vec<&ResolvedRun> = experiment.runs.iter().collect();
     let budget = MemoryBudget::new(options.memory);
     // Runs another process held but ended without writing come back for another pass.
     while !runs.is_empty() {
@@ -96,17 +94,17 @@ pub fn run_experiment(experiment: &Experiment, options: &RunOptions) -> io::Resu
 fn run_pass<'a>(
     dir: &Path,
     name: &str,
-    runs: &[&'a RunSpec],
+    runs: &[&'a ResolvedRun],
     options: &RunOptions,
     budget: &MemoryBudget,
     outcome: &mut MatrixOutcome,
-) -> io::Result<Vec<&'a RunSpec>> {
-    let (todo, done): (Vec<&RunSpec>, Vec<&RunSpec>) = runs
+) -> io::Result<Vec<&'a ResolvedRun>> {
+    let (todo, done): (Vec<&ResolvedRun>, Vec<&ResolvedRun>) = runs
         .iter()
-        .partition(|run| needs_run(dir, &run.run_id, options.force));
+        .partition(|run| needs_run(dir, &run.spec.run_id, options.force));
     // A skipped run still gets the XDMF description it lacks.
     for run in &done {
-        describe_if_missing(&run_path(dir, &run.run_id))?;
+        describe_if_missing(&run_path(dir, &run.spec.run_id))?;
     }
     let mut todo = todo;
     // Longest first, so the pool does not end waiting on one large run.
@@ -118,24 +116,27 @@ fn run_pass<'a>(
         .build()
         .map_err(io::Error::other)?;
     let claims = locks::Claims::new(dir, options.force);
-    let results: Vec<(&RunSpec, io::Result<(RunStatus, String)>)> = pool.install(|| {
+    let results: Vec<(&ResolvedRun, io::Result<(RunStatus, String)>)> = pool.install(|| {
         todo.par_iter()
             .filter(|run| claims.take(run))
             .map(|&run| {
-                let bytes = estimated_bytes(run);
+                let job = Job::new(run);
+                let bytes = job.estimated_bytes();
                 let result = match budget.refusal(bytes) {
                     Some(message) => record_failure(dir, run, message),
                     None => {
                         let _hold = budget.hold(bytes);
-                        with_threads(options.threads, || execute(dir, run, simulate_into))
-                            .unwrap_or_else(|e| {
+                        let compute = |file: &hdf5::File| job.compute(Some(file));
+                        with_threads(options.threads, || execute(dir, run, compute)).unwrap_or_else(
+                            |e| {
                                 let message = format!("its threads could not be started: {e}");
                                 record_failure(dir, run, message)
-                            })
+                            },
+                        )
                     }
                 };
                 if result.is_ok() {
-                    claims.release(&run.run_id);
+                    claims.release(&run.spec.run_id);
                 }
                 progress.inc(1);
                 (run, result)
@@ -146,7 +147,7 @@ fn run_pass<'a>(
 
     outcome.skipped += done.len();
     for (run, result) in results {
-        let run_id = &run.run_id;
+        let run_id = &run.spec.run_id;
         match result {
             Ok((status, message)) => {
                 outcome.written += 1;
@@ -189,11 +190,11 @@ fn needs_run(dir: &Path, run_id: &str, force: bool) -> bool {
 /// not even that file could be written.
 fn execute(
     dir: &Path,
-    run: &RunSpec,
-    simulate: impl FnOnce(&RunSpec, &hdf5::File) -> RunRecord,
+    run: &ResolvedRun,
+    compute: impl FnOnce(&hdf5::File) -> RunRecord,
 ) -> io::Result<(RunStatus, String)> {
     let computed = panic::catch_unwind(AssertUnwindSafe(|| {
-        compute_run(dir, &run.run_id, |file| simulate(run, file))
+        compute_run(dir, &run.spec.run_id, compute)
     }));
     let message = match computed {
         Ok(Ok(record)) => return Ok((record.status, record.message)),
@@ -204,7 +205,11 @@ fn execute(
 }
 
 /// Writes the file of a run that failed with `message` before or while it ran.
-fn record_failure(dir: &Path, run: &RunSpec, message: String) -> io::Result<(RunStatus, String)> {
+fn record_failure(
+    dir: &Path,
+    run: &ResolvedRun,
+    message: String,
+) -> io::Result<(RunStatus, String)> {
     match write_run(dir, &base_record(run, message.clone())) {
         Ok(_) => Ok((RunStatus::Failed, message)),
         Err(e) => Err(io::Error::other(format!(
@@ -223,24 +228,14 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
 }
 
 /// A run's cost in particle-steps: its particles (`cells * ppc` per axis) times the time
-/// steps its problem takes to the final time. A reconstruction benchmark takes no steps and
-/// costs its points. The runner starts the costliest runs first and `shard` balances shards
-/// by this, across experiments, so it is computed from the validated parameters alone and is
-/// the same on every machine.
-pub fn estimated_cost(run: &RunSpec) -> u64 {
-    let dim = crate::benchmarks::CATALOG
-        .find(&run.benchmark)
-        .map_or(1, |b| b.dim()) as u32;
-    let cells = get_usize(&run.params, "cells").unwrap_or(1) as u64;
-    let ppc = get_usize(&run.params, "ppc").unwrap_or(1) as u64;
-    let particles = cells.saturating_mul(ppc).saturating_pow(dim);
-    // Building a problem only reads its parameters (dt, step count); it has no particles yet.
-    let steps = match crate::benchmarks::build(&run.benchmark, &run.params) {
-        Ok(AnyProblem::D1(problem)) => problem.steps(),
-        Ok(AnyProblem::D2(problem)) => problem.steps(),
-        Err(_) => 1,
-    };
-    particles.saturating_mul(steps.max(1) as u64)
+/// steps to the final time. A reconstruction benchmark takes no steps and costs its points.
+/// The runner starts the costliest runs first and `shard` balances shards by this, across
+/// experiments, so it is computed from the validated parameters alone and is the same on
+/// every machine.
+pub fn estimated_cost(run: &ResolvedRun) -> u64 {
+    let (cells, ppc) = (run.cells.max(1) as u64, run.ppc.max(1) as u64);
+    let particles = cells.saturating_mul(ppc).saturating_pow(run.dim() as u32);
+    particles.saturating_mul(run.steps.unwrap_or(1).max(1) as u64)
 }
 
 /// Experiments run or submitted together must differ in `name`, since each writes to
@@ -349,7 +344,7 @@ mod tests {
     use crate::output::{open_run_file, read_summary};
 
     /// Two runs of a small bar.
-    fn runs() -> Vec<RunSpec> {
+    fn runs() -> Vec<ResolvedRun> {
         let yaml = "name: t\nbenchmark: vibrating_bar\nparams: {method: mpm}\n\
                     matrix:\n  cells: [4, 5]\n";
         crate::experiment::parse(yaml, Path::new("t.yaml"))
@@ -357,8 +352,8 @@ mod tests {
             .runs
     }
 
-    fn status(dir: &Path, run: &RunSpec) -> (RunStatus, String) {
-        let file = open_run_file(&run_path(dir, &run.run_id)).unwrap();
+    fn status(dir: &Path, run: &ResolvedRun) -> (RunStatus, String) {
+        let file = open_run_file(&run_path(dir, &run.spec.run_id)).unwrap();
         let summary = read_summary(&file).unwrap();
         (summary.status, summary.message)
     }
@@ -369,7 +364,7 @@ mod tests {
     fn a_panicking_run_is_recorded_as_failed_and_the_next_goes_on() {
         let dir = tempfile::tempdir().unwrap();
         let runs = runs();
-        let panicking = |_: &RunSpec, file: &hdf5::File| -> RunRecord {
+        let panicking = |file: &hdf5::File| -> RunRecord {
             file.create_group("history").unwrap();
             panic!("boom")
         };
@@ -377,7 +372,8 @@ mod tests {
         assert_eq!(status_of_first, RunStatus::Failed);
         assert_eq!(message, "stopped by an internal error: boom");
         assert_eq!(status(dir.path(), &runs[0]), (RunStatus::Failed, message));
-        let (second, _) = execute(dir.path(), &runs[1], simulate_into).unwrap();
+        let compute = |file: &hdf5::File| Job::new(&runs[1]).compute(Some(file));
+        let (second, _) = execute(dir.path(), &runs[1], compute).unwrap();
         assert_eq!(second, RunStatus::Ok);
         assert_eq!(status(dir.path(), &runs[1]).0, RunStatus::Ok);
         let leftovers: Vec<_> = fs::read_dir(dir.path().join("runs"))

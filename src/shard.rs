@@ -72,7 +72,7 @@ impl Plan {
         for experiment in experiments {
             for run in &experiment.runs {
                 costs
-                    .entry((experiment.name.clone(), run.run_id.clone()))
+                    .entry((experiment.name.clone(), run.spec.run_id.clone()))
                     .or_insert_with(|| estimated_cost(run));
             }
         }
@@ -113,7 +113,7 @@ impl Plan {
     pub fn select(&self, experiment: &Experiment, index: usize) -> Experiment {
         let mut part = experiment.clone();
         part.runs
-            .retain(|run| self.shard_of(&experiment.name, &run.run_id) == Some(index));
+            .retain(|run| self.shard_of(&experiment.name, &run.spec.run_id) == Some(index));
         part
     }
 
@@ -124,9 +124,11 @@ impl Plan {
         for experiment in experiments {
             let dir = results_dir(out, experiment);
             for run in &experiment.runs {
-                if !run_path(&dir, &run.run_id).exists() {
-                    let shard = self.shard_of(&experiment.name, &run.run_id).unwrap_or(0);
-                    missing.push((shard, experiment.name.clone(), run.run_id.clone()));
+                if !run_path(&dir, &run.spec.run_id).exists() {
+                    let shard = self
+                        .shard_of(&experiment.name, &run.spec.run_id)
+                        .unwrap_or(0);
+                    missing.push((shard, experiment.name.clone(), run.spec.run_id.clone()));
                 }
             }
         }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use mpmlab::benchmarks::thesis_params;
 use mpmlab::experiment;
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::methods::{COMPOSED, GAMMA_KEY};
 use mpmlab::output::{RunRecord, RunStatus};
 use mpmlab::params::{ParamValue, Params};
@@ -15,16 +16,19 @@ use mpmlab::solver::simulate;
 fn run(method: &str, extra: &[(&str, ParamValue)]) -> RunRecord {
     let mut params = thesis_params(1e-4, 16, 2);
     params.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
-    let record = simulate(&RunSpec {
-        experiment: "composed_methods".into(),
-        run_id: method.into(),
-        benchmark: "mms1d_gong".into(),
-        method: method.into(),
-        params,
-        axes: Params::new(),
-        output_every: 4,
-        config_yaml: String::new(),
-    });
+    let record = simulate(
+        &ResolvedRun::resolve(RunSpec {
+            experiment: "composed_methods".into(),
+            run_id: method.into(),
+            benchmark: "mms1d_gong".into(),
+            method: method.into(),
+            params,
+            axes: Params::new(),
+            output_every: 4,
+            config_yaml: String::new(),
+        })
+        .unwrap(),
+    );
     assert_eq!(record.status, RunStatus::Ok, "{method}: {}", record.message);
     record
 }
@@ -81,9 +85,9 @@ matrix:
 #[test]
 fn parts_are_matrix_axes_with_or_without_a_preset() {
     let e = experiment::parse(PARTS_AS_AXES, Path::new("parts.yaml")).unwrap();
-    let methods: Vec<&str> = e.runs.iter().map(|r| r.method.as_str()).collect();
+    let methods: Vec<&str> = e.runs.iter().map(|r| r.spec.method.as_str()).collect();
     assert_eq!(methods, [COMPOSED, COMPOSED, COMPOSED, COMPOSED, "mpm"]);
-    let ids: Vec<&str> = e.runs.iter().map(|r| r.run_id.as_str()).collect();
+    let ids: Vec<&str> = e.runs.iter().map(|r| r.spec.run_id.as_str()).collect();
     assert!(
         ids[..4].iter().all(|id| id.starts_with("composed-")),
         "{ids:?}"
@@ -92,8 +96,8 @@ fn parts_are_matrix_axes_with_or_without_a_preset() {
     let linear_fitted = &e.runs[1];
     assert_eq!(
         (
-            linear_fitted.params.get("shape"),
-            linear_fitted.params.get("transfer")
+            linear_fitted.spec.params.get("shape"),
+            linear_fitted.spec.params.get("transfer")
         ),
         (Some(&text("linear")), Some(&text("mls_velocity")))
     );
@@ -169,9 +173,9 @@ fn the_component_matrices_run_every_valid_combination_once() {
             .runs
             .iter()
             .map(|r| {
-                ["shape", "transfer", "integrator"].map(|k| match r.params.get(k) {
+                ["shape", "transfer", "integrator"].map(|k| match r.spec.params.get(k) {
                     Some(ParamValue::Str(s)) => s.clone(),
-                    other => panic!("{file}: {}: {k} is {other:?}", r.run_id),
+                    other => panic!("{file}: {}: {k} is {other:?}", r.spec.run_id),
                 })
             })
             .collect();

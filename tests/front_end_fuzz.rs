@@ -394,14 +394,14 @@ fn run_mutant(experiment: &Experiment, out: &Path) -> Result<(), String> {
     }
     let dir = results_dir(out, experiment);
     for run in &experiment.runs {
-        let path = run_path(&dir, &run.run_id);
+        let path = run_path(&dir, &run.spec.run_id);
         let summary = open_run_file(&path)
             .and_then(|file| read_summary(&file))
-            .map_err(|e| format!("run {} has no readable file: {e}", run.run_id))?;
+            .map_err(|e| format!("run {} has no readable file: {e}", run.spec.run_id))?;
         if summary.status == RunStatus::Failed && summary.message.contains("panicked") {
             return Err(format!(
                 "run {} failed internally: {}",
-                run.run_id, summary.message
+                run.spec.run_id, summary.message
             ));
         }
     }

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mpmlab::benchmarks::{self, AnyProblem, Problem};
+use mpmlab::benchmarks::{AnyProblem, Problem};
 use mpmlab::experiment;
 use mpmlab::output::{RunRecord, RunStatus};
 use mpmlab::run_spec::RunSpec;
@@ -53,12 +53,12 @@ fn label(spec: &RunSpec) -> String {
 fn the_grid_velocity_is_compared_at_the_time_it_belongs_to() {
     let exp = experiment::parse(MATRIX, Path::new("grid_velocity_time.yaml")).unwrap();
     assert_eq!(exp.runs.len(), 6);
-    for spec in &exp.runs {
+    for run in &exp.runs {
+        let spec = &run.spec;
         let name = label(spec);
-        let record = simulate(spec);
+        let record = simulate(run);
         assert_eq!(record.status, RunStatus::Ok, "{name}: {}", record.message);
-        let AnyProblem::D1(problem) = benchmarks::build(&spec.benchmark, &spec.params).unwrap()
-        else {
+        let AnyProblem::D1(problem) = run.benchmark.problem(&spec.params).unwrap() else {
             unreachable!("mms1d_gong is 1D")
         };
         let t = *record.history.time.last().unwrap();
@@ -102,10 +102,11 @@ fn the_grid_velocity_is_that_of_the_material_at_the_dof_at_the_step() {
         .replace("G: 1.0e-4", "G: 0.1")
         .replace("cells: 32", "cells: 256");
     let exp = experiment::parse(&text, Path::new("grid_velocity_time.yaml")).unwrap();
-    let spec = exp.runs.iter().find(|r| r.method == "impm").unwrap();
-    let record = simulate(spec);
+    let run = exp.runs.iter().find(|r| r.spec.method == "impm").unwrap();
+    let spec = &run.spec;
+    let record = simulate(run);
     assert_eq!(record.status, RunStatus::Ok, "{}", record.message);
-    let AnyProblem::D1(problem) = benchmarks::build(&spec.benchmark, &spec.params).unwrap() else {
+    let AnyProblem::D1(problem) = run.benchmark.problem(&spec.params).unwrap() else {
         unreachable!("mms1d_gong is 1D")
     };
     let t = *record.history.time.last().unwrap();

@@ -3,22 +3,26 @@
 //! (`impm_fields_only`), against `mpm` and `impm` (docs/NOTES.md, experiments/gong_impm_isolation.yaml).
 
 use mpmlab::benchmarks::thesis_params;
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::output::{RunRecord, RunStatus, ERROR_FIELDS};
 use mpmlab::params::Params;
 use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 fn run(benchmark: &str, method: &str, g: f64, cells: i64) -> RunRecord {
-    let record = simulate(&RunSpec {
-        experiment: "impm_parts".into(),
-        run_id: method.into(),
-        benchmark: benchmark.into(),
-        method: method.into(),
-        params: thesis_params(g, cells, 2),
-        axes: Params::new(),
-        output_every: 8,
-        config_yaml: String::new(),
-    });
+    let record = simulate(
+        &ResolvedRun::resolve(RunSpec {
+            experiment: "impm_parts".into(),
+            run_id: method.into(),
+            benchmark: benchmark.into(),
+            method: method.into(),
+            params: thesis_params(g, cells, 2),
+            axes: Params::new(),
+            output_every: 8,
+            config_yaml: String::new(),
+        })
+        .unwrap(),
+    );
     assert_eq!(record.status, RunStatus::Ok, "{method}: {}", record.message);
     record
 }

@@ -31,13 +31,14 @@ fn runs() -> Vec<(String, f64, String, f64, RunRecord)> {
             let record = simulate(spec);
             assert_eq!(record.status, RunStatus::Ok, "{}", record.message);
             let gamma = spec
+                .spec
                 .params
                 .get("gamma")
                 .and_then(|g| g.as_f64())
                 .unwrap_or(0.0);
-            let integrator = spec.params["integrator"].as_str().unwrap().to_string();
-            let cfl = spec.params["cfl"].as_f64().unwrap();
-            (spec.method.clone(), gamma, integrator, cfl, record)
+            let integrator = spec.spec.params["integrator"].as_str().unwrap().to_string();
+            let cfl = spec.spec.params["cfl"].as_f64().unwrap();
+            (spec.spec.method.clone(), gamma, integrator, cfl, record)
         })
         .collect()
 }

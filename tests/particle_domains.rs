@@ -1,22 +1,26 @@
 //! The particle-domain methods stepped end to end on Gong's manufactured solutions.
 
 use mpmlab::benchmarks::thesis_params;
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::output::{RunRecord, RunStatus};
 use mpmlab::params::Params;
 use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 fn run(benchmark: &str, method: &str, g: f64, cells: i64, ppc: i64) -> RunRecord {
-    let record = simulate(&RunSpec {
-        experiment: "particle_domains".into(),
-        run_id: method.into(),
-        benchmark: benchmark.into(),
-        method: method.into(),
-        params: thesis_params(g, cells, ppc),
-        axes: Params::new(),
-        output_every: 8,
-        config_yaml: String::new(),
-    });
+    let record = simulate(
+        &ResolvedRun::resolve(RunSpec {
+            experiment: "particle_domains".into(),
+            run_id: method.into(),
+            benchmark: benchmark.into(),
+            method: method.into(),
+            params: thesis_params(g, cells, ppc),
+            axes: Params::new(),
+            output_every: 8,
+            config_yaml: String::new(),
+        })
+        .unwrap(),
+    );
     assert_eq!(record.status, RunStatus::Ok, "{method}: {}", record.message);
     record
 }

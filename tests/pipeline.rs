@@ -79,19 +79,21 @@ fn runs_are_reproducible_skipped_and_divergence_is_recorded() {
     let dir_a = results_dir(&a, &exp);
     let dir_b = results_dir(&b, &exp);
     for run in &exp.runs {
-        let (pa, pb): (PathBuf, PathBuf) =
-            (run_path(&dir_a, &run.run_id), run_path(&dir_b, &run.run_id));
+        let (pa, pb): (PathBuf, PathBuf) = (
+            run_path(&dir_a, &run.spec.run_id),
+            run_path(&dir_b, &run.spec.run_id),
+        );
         assert_eq!(
             bits(&datasets(&pa)),
             bits(&datasets(&pb)),
             "{} differs with --jobs",
-            run.run_id
+            run.spec.run_id
         );
     }
 
     // A rerun skips complete runs, writing the XDMF description a run lacks; --force redoes
     // them bit for bit.
-    let description = xdmf_path(&run_path(&dir_a, &exp.runs[0].run_id));
+    let description = xdmf_path(&run_path(&dir_a, &exp.runs[0].spec.run_id));
     let text = std::fs::read(&description).unwrap();
     std::fs::remove_file(&description).unwrap();
     let again = run_experiment(&exp, &options(&a, 1, false)).unwrap();
@@ -100,14 +102,14 @@ fn runs_are_reproducible_skipped_and_divergence_is_recorded() {
     let before: Vec<_> = exp
         .runs
         .iter()
-        .map(|r| bits(&datasets(&run_path(&dir_a, &r.run_id))))
+        .map(|r| bits(&datasets(&run_path(&dir_a, &r.spec.run_id))))
         .collect();
     let forced = run_experiment(&exp, &options(&a, 2, true)).unwrap();
     assert_eq!(forced.written, 2);
     let after: Vec<_> = exp
         .runs
         .iter()
-        .map(|r| bits(&datasets(&run_path(&dir_a, &r.run_id))))
+        .map(|r| bits(&datasets(&run_path(&dir_a, &r.spec.run_id))))
         .collect();
     assert_eq!(before, after);
 
@@ -152,7 +154,7 @@ fn report_lists_missing_runs() {
     let exp = experiment::load(&yaml).unwrap();
     run_experiment(&exp, &options(tmp.path(), 1, false)).unwrap();
     let dir = results_dir(tmp.path(), &exp);
-    std::fs::remove_file(run_path(&dir, &exp.runs[0].run_id)).unwrap();
+    std::fs::remove_file(run_path(&dir, &exp.runs[0].spec.run_id)).unwrap();
     let collected = collect(&dir).unwrap();
-    assert_eq!(collected.missing, vec![exp.runs[0].run_id.clone()]);
+    assert_eq!(collected.missing, vec![exp.runs[0].spec.run_id.clone()]);
 }

@@ -85,7 +85,7 @@ fn record<'a>(
     collected: &'a mpmlab::collect::Collected,
     axes: &[(&str, &str)],
 ) -> &'a ReconstructionRecord {
-    find(collected, axes).reconstruction.as_ref().unwrap()
+    find(collected, axes).unstepped.reconstruction().unwrap()
 }
 
 /// The element-wise record of the run whose axes have these values.
@@ -93,7 +93,7 @@ fn elements<'a>(
     collected: &'a mpmlab::collect::Collected,
     axes: &[(&str, &str)],
 ) -> &'a ElementRecord {
-    find(collected, axes).elements.as_ref().unwrap()
+    find(collected, axes).unstepped.elements().unwrap()
 }
 
 #[test]

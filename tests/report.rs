@@ -9,7 +9,9 @@ use mpmlab::experiment::{
     ClaimedValue, Expectation, Experiment, FieldMapSpec, FigureKind, FigureSpec, OutputSpec,
     PaperClaim, ProbeWindow, Selection, TableKind, TableSpec,
 };
-use mpmlab::output::{ParticleState, ProbeRecord, RunStatus, RunSummary, ERROR_FIELDS, NORMS};
+use mpmlab::output::{
+    ParticleState, ProbeRecord, RunStatus, RunSummary, Unstepped, ERROR_FIELDS, NORMS,
+};
 use mpmlab::params::{ParamValue, Params};
 use mpmlab::report::claims::{self, Verdict};
 use mpmlab::report::{check, figures, fit_rates, index, write_report, CheckFailure};
@@ -63,9 +65,7 @@ fn run(g: &str, method: &str, cells: usize) -> RunSummary {
         step_seconds: 1e-4 * cells as f64,
         axes: params(&[("G", g), ("method", method), ("cells", &cells.to_string())]),
         final_norms,
-        reconstruction: None,
-        elements: None,
-        shape_functions: None,
+        unstepped: Unstepped::None,
         velocity_history: None,
         max_mass_error: f64::NAN,
         max_momentum_error: f64::NAN,

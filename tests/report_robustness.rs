@@ -51,12 +51,13 @@ fn run_file(experiment: &Experiment, dir: &Path, cells: i64) -> PathBuf {
         .runs
         .iter()
         .find(|r| {
-            r.params
+            r.spec
+                .params
                 .get("cells")
                 .is_some_and(|v| v.to_string() == cells.to_string())
         })
         .unwrap();
-    run_path(dir, &run.run_id)
+    run_path(dir, &run.spec.run_id)
 }
 
 /// Every file of a results directory but its run files, with its bytes.

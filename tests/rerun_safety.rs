@@ -39,7 +39,7 @@ fn a_rerun_removes_what_dead_processes_left_and_nothing_else() {
     assert!(first.status.success(), "{}", stderr(&first));
     let exp = experiment::load(&file).unwrap();
     let dir = results_dir(out.path(), &exp);
-    let id = &exp.runs[0].run_id;
+    let id = &exp.runs[0].spec.run_id;
     let me = std::process::id();
     let (host, tag) = (this_host(), host_tag());
     let dead = [
@@ -191,7 +191,11 @@ fn two_runs_on_one_out_compute_each_run_once() {
     assert_eq!(b.iter().sum::<usize>(), runs, "{b:?}");
     let dir = results_dir(out.path(), &exp);
     for run in &exp.runs {
-        assert!(run_path(&dir, &run.run_id).exists(), "{}", run.run_id);
+        assert!(
+            run_path(&dir, &run.spec.run_id).exists(),
+            "{}",
+            run.spec.run_id
+        );
     }
     let left: Vec<String> = fs::read_dir(dir.join("runs"))
         .unwrap()

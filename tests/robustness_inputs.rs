@@ -9,13 +9,14 @@ use std::process::{Command, Stdio};
 
 use mpmlab::benchmarks::{self, AnyProblem, MAX_POINTS, MAX_STEPS};
 use mpmlab::experiment::{
-    self, ConfigError, Experiment, MAX_LIST_VALUES, MAX_NAME_LEN, MAX_RUN_ID_LEN, MAX_SAMPLES,
+    self, ConfigError, Experiment, ResolvedRun, MAX_LIST_VALUES, MAX_NAME_LEN, MAX_RUN_ID_LEN,
+    MAX_SAMPLES,
 };
 use mpmlab::output::{open_run_file, read_summary, run_path, RunStatus};
 use mpmlab::params::ParamValue;
 use mpmlab::runner::{results_dir, run_experiment, RunOptions, REFUSED};
 use mpmlab::shape::MAX_STENCIL_NODES;
-use mpmlab::solver::estimated_bytes;
+use mpmlab::solver::Job;
 
 const DIR: &str = "tests/inputs/robustness";
 
@@ -111,7 +112,10 @@ fn a_tiny_rho0_is_refused_at_its_step_count() {
 #[test]
 fn max_steps_raises_the_bound() {
     let runs = load("max_steps_raised.yaml").unwrap().runs;
-    assert_eq!(runs[0].params["max_steps"], ParamValue::Int(30_000_000));
+    assert_eq!(
+        runs[0].spec.params["max_steps"],
+        ParamValue::Int(30_000_000)
+    );
     let text = std::fs::read_to_string(path("max_steps_raised.yaml")).unwrap();
     let without = text.replace(",\n         max_steps: 30000000", "");
     assert_ne!(without, text);
@@ -121,7 +125,8 @@ fn max_steps_raises_the_bound() {
 }
 
 /// Every simulation run of the committed experiments steps with the time step its check
-/// approves: the problem's dt and step count are those of the benchmark's `time_step`.
+/// approves: the problem's dt and step count are those of the benchmark's `time_step`, and
+/// the resolved run carries that step count.
 #[test]
 fn runs_take_the_time_step_their_check_approves() {
     let mut compared = 0;
@@ -132,12 +137,13 @@ fn runs_take_the_time_step_their_check_approves() {
             continue;
         };
         for run in &experiment.runs {
-            let step = time_step(&run.params).unwrap();
-            let (dt, steps) = match benchmarks::build(&run.benchmark, &run.params).unwrap() {
+            let step = time_step(&run.spec.params).unwrap();
+            let (dt, steps) = match run.benchmark.problem(&run.spec.params).unwrap() {
                 AnyProblem::D1(p) => (p.dt(), p.steps()),
                 AnyProblem::D2(p) => (p.dt(), p.steps()),
             };
-            assert_eq!((dt, steps), (step.dt, step.steps), "{}", run.run_id);
+            assert_eq!((dt, steps), (step.dt, step.steps), "{}", run.spec.run_id);
+            assert_eq!(run.steps, Some(steps), "{}", run.spec.run_id);
             compared += 1;
         }
     }
@@ -218,16 +224,19 @@ fn fits(id: &str) -> bool {
 fn long_list_values_give_bounded_run_ids() {
     let runs = load("long_points_list.yaml").unwrap().runs;
     assert_eq!(
-        runs[0].run_id,
+        runs[0].spec.run_id,
         "imls_quadratic-points-0.5_0.0_0.5-26e231655be8"
     );
     assert!(
-        runs[1].run_id.starts_with("imls_quadratic-pointslist40-"),
+        runs[1]
+            .spec
+            .run_id
+            .starts_with("imls_quadratic-pointslist40-"),
         "{}",
-        runs[1].run_id
+        runs[1].spec.run_id
     );
-    assert!(runs.iter().all(|r| fits(&r.run_id)));
-    assert_eq!(runs[1].params["points"].as_list().unwrap().len(), 40);
+    assert!(runs.iter().all(|r| fits(&r.spec.run_id)));
+    assert_eq!(runs[1].spec.params["points"].as_list().unwrap().len(), 40);
 }
 
 /// `points` as a matrix axis of one list of `n` values in [-1, 1].
@@ -250,11 +259,15 @@ fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {
     let text = points_axis(20_000);
     let experiment = experiment::parse(&text, Path::new("many_points.yaml")).unwrap();
     let run = &experiment.runs[0];
-    let id = &run.run_id;
+    let id = &run.spec.run_id;
     assert!(id.starts_with("imls_quadratic-pointslist20000-"), "{id}");
     assert!(fits(id), "{id}");
-    assert_eq!(run.params["points"].as_list().unwrap().len(), 20_000);
-    assert!(run.config_yaml.len() > 1 << 16, "{}", run.config_yaml.len());
+    assert_eq!(run.spec.params["points"].as_list().unwrap().len(), 20_000);
+    assert!(
+        run.spec.config_yaml.len() > 1 << 16,
+        "{}",
+        run.spec.config_yaml.len()
+    );
 
     let out = tempfile::tempdir().unwrap();
     let options = RunOptions {
@@ -273,10 +286,10 @@ fn a_list_of_twenty_thousand_values_expands_with_a_bounded_id_and_is_written() {
     let dir = results_dir(out.path(), &experiment);
     let file = open_run_file(&run_path(&dir, id)).unwrap();
     let summary = read_summary(&file).unwrap();
-    assert_eq!(summary.axes["points"], run.params["points"]);
+    assert_eq!(summary.axes["points"], run.spec.params["points"]);
     let stored: hdf5::types::VarLenUnicode =
         file.dataset("config_yaml").unwrap().read_scalar().unwrap();
-    assert_eq!(stored.as_str(), run.config_yaml);
+    assert_eq!(stored.as_str(), run.spec.config_yaml);
 }
 
 #[test]
@@ -384,7 +397,8 @@ fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
                 matrix:\n  cells: [4, 400]\n";
     let experiment = experiment::parse(yaml, Path::new("memory.yaml")).unwrap();
     let [small, large] = [&experiment.runs[0], &experiment.runs[1]];
-    let (need_small, need_large) = (estimated_bytes(small), estimated_bytes(large));
+    let need = |run| Job::new(run).estimated_bytes();
+    let (need_small, need_large) = (need(small), need(large));
     assert!(need_small < need_large, "{need_small} {need_large}");
     let out = tempfile::tempdir().unwrap();
     let mut options = RunOptions {
@@ -402,7 +416,7 @@ fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
     );
     let failure = &outcome.failed[0];
     assert!(
-        failure.starts_with(&format!("{}: {REFUSED}", large.run_id)),
+        failure.starts_with(&format!("{}: {REFUSED}", large.spec.run_id)),
         "{failure}"
     );
     assert!(
@@ -410,8 +424,8 @@ fn a_run_that_cannot_fit_is_refused_and_computed_by_a_rerun_that_has_room() {
         "{failure}"
     );
     let dir = results_dir(out.path(), &experiment);
-    let summary = |run: &mpmlab::run_spec::RunSpec| {
-        read_summary(&open_run_file(&run_path(&dir, &run.run_id)).unwrap()).unwrap()
+    let summary = |run: &ResolvedRun| {
+        read_summary(&open_run_file(&run_path(&dir, &run.spec.run_id)).unwrap()).unwrap()
     };
     assert_eq!(summary(large).status, RunStatus::Failed);
     assert_eq!(summary(small).status, RunStatus::Ok);

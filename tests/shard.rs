@@ -32,7 +32,11 @@ fn load_dir(dir: &str) -> Vec<Experiment> {
 fn keys(experiments: &[Experiment]) -> BTreeSet<(String, String)> {
     experiments
         .iter()
-        .flat_map(|e| e.runs.iter().map(|r| (e.name.clone(), r.run_id.clone())))
+        .flat_map(|e| {
+            e.runs
+                .iter()
+                .map(|r| (e.name.clone(), r.spec.run_id.clone()))
+        })
         .collect()
 }
 
@@ -105,7 +109,7 @@ fn equal_costs_go_round_robin_in_run_id_order() {
     let cost = estimated_cost(&exp.runs[0]);
     assert!(exp.runs.iter().all(|r| estimated_cost(r) == cost));
     let plan = Plan::new(std::slice::from_ref(&exp), 3);
-    let mut ids: Vec<&str> = exp.runs.iter().map(|r| r.run_id.as_str()).collect();
+    let mut ids: Vec<&str> = exp.runs.iter().map(|r| r.spec.run_id.as_str()).collect();
     ids.sort();
     let shards: Vec<usize> = ids
         .iter()
@@ -211,7 +215,7 @@ fn shards_run_one_by_one_give_the_single_run_files() {
             std::fs::read(merged.join("experiment.yaml")).unwrap()
         );
         for run in &experiment.runs {
-            assert!(run_path(&merged, &run.run_id).exists());
+            assert!(run_path(&merged, &run.spec.run_id).exists());
         }
     }
 

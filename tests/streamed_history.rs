@@ -11,9 +11,9 @@ use hdf5::{Attribute, Dataset, Group};
 
 use mpmlab::experiment;
 
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::output::{compute_run, run_path, write_hdf5};
-use mpmlab::run_spec::RunSpec;
-use mpmlab::solver::{simulate, simulate_into};
+use mpmlab::solver::{simulate, Job};
 
 /// A value of a dataset or attribute, comparable bit for bit.
 #[derive(Debug, PartialEq)]
@@ -81,11 +81,15 @@ fn file_contents(path: &Path) -> Vec<(String, Stored)> {
 }
 
 /// Writes `spec` both ways and compares the two files; returns the number of values compared.
-fn check(spec: &RunSpec) -> usize {
+fn check(run: &ResolvedRun) -> usize {
+    let spec = &run.spec;
     let dir = tempfile::tempdir().unwrap();
     let whole = dir.path().join("whole.h5");
-    write_hdf5(&whole, &simulate(spec)).unwrap();
-    let streamed = compute_run(dir.path(), &spec.run_id, |file| simulate_into(spec, file)).unwrap();
+    write_hdf5(&whole, &simulate(run)).unwrap();
+    let streamed = compute_run(dir.path(), &spec.run_id, |file| {
+        Job::new(run).compute(Some(file))
+    })
+    .unwrap();
     assert!(streamed.history.x.is_empty() || streamed.history.time.is_empty());
     let a = file_contents(&whole);
     let b = file_contents(&run_path(dir.path(), &spec.run_id));
@@ -155,6 +159,6 @@ fn histories_of_many_samples_span_chunks_and_equal_the_whole() {
         .unwrap()
         .runs;
     let mut spec = molinos[0].clone();
-    spec.output_every = 1;
+    spec.spec.output_every = 1;
     check(&spec);
 }

@@ -43,14 +43,14 @@ fn results_are_bitwise_the_same_for_any_thread_count() {
             "{}",
             sequential.message
         );
-        assert!(sequential.history.x.len() > 4096, "{}", spec.run_id);
+        assert!(sequential.history.x.len() > 4096, "{}", spec.spec.run_id);
         let expected = record_text(sequential);
         for threads in [1, 3] {
             let record = with_threads(threads, || simulate(spec)).unwrap();
             assert!(
                 record_text(record) == expected,
                 "{} with {threads} threads differs from the sequential run",
-                spec.run_id
+                spec.spec.run_id
             );
         }
     }

@@ -13,8 +13,8 @@ use std::path::Path;
 
 use mpmlab::experiment;
 
+use mpmlab::experiment::ResolvedRun;
 use mpmlab::output::{RunRecord, RunStatus};
-use mpmlab::run_spec::RunSpec;
 use mpmlab::solver::simulate;
 
 /// Time steps from Courant number 0.24 down to 0.03 (c = 59.2 m/s, h = 0.1 m); 0.05 s is
@@ -42,11 +42,13 @@ fn last_sample(record: &RunRecord) -> [Vec<f64>; 3] {
 /// The last samples of the runs of `method` with `integrator`, coarsest time step first.
 fn final_states(method: &str, integrator: &str) -> Vec<[Vec<f64>; 3]> {
     let exp = experiment::parse(MATRIX, Path::new("time_order.yaml")).unwrap();
-    let dt = |r: &RunSpec| r.params["dt"].as_f64().unwrap();
-    let mut runs: Vec<&RunSpec> = exp
+    let dt = |r: &ResolvedRun| r.spec.params["dt"].as_f64().unwrap();
+    let mut runs: Vec<&ResolvedRun> = exp
         .runs
         .iter()
-        .filter(|r| r.method == method && r.params["integrator"].as_str() == Some(integrator))
+        .filter(|r| {
+            r.spec.method == method && r.spec.params["integrator"].as_str() == Some(integrator)
+        })
         .collect();
     runs.sort_by(|a, b| dt(b).total_cmp(&dt(a)));
     assert_eq!(runs.len(), 4, "{method} with {integrator}");

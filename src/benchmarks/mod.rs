@@ -366,22 +366,6 @@ pub enum AnyProblem {
     D2(Box<dyn Problem<2>>),
 }
 
-/// Builds the named simulation benchmark from validated parameters.
-pub fn build(name: &str, params: &Params) -> Result<AnyProblem, ParamError> {
-    CATALOG
-        .find(name)
-        .ok_or_else(|| {
-            ParamError::new(
-                "benchmark",
-                format!(
-                    "unknown benchmark '{name}'; valid: {}",
-                    CATALOG.names().join(", ")
-                ),
-            )
-        })?
-        .problem(params)
-}
-
 /// Boxes a benchmark's problem for `Build`.
 fn boxed<P: Problem<D> + 'static, const D: usize>(
     problem: Result<P, ParamError>,
@@ -437,8 +421,9 @@ mod tests {
             .filter(|i| i.kind == BenchmarkKind::Simulation)
         {
             let params = runnable_params(info);
-            let problem =
-                build(info.name, &params).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+            let problem = info
+                .problem(&params)
+                .unwrap_or_else(|e| panic!("{}: {e}", info.name));
             let inverts = match problem {
                 AnyProblem::D1(p) => {
                     let (lo, hi) = p.body();

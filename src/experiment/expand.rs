@@ -11,6 +11,7 @@ use crate::reference;
 
 use super::document::Benchmark;
 use super::error::{ConfigError, Pos};
+use super::resolved::{ResolvedRun, RunMethod};
 use super::run_id::{config_body, config_yaml, run_id};
 use super::space::{Block, ParamSpace, Written};
 use super::values::{method_names, METHOD_KEY};
@@ -39,24 +40,24 @@ pub(crate) fn expand(
     benchmark: &Benchmark,
     space: &ParamSpace,
     sampling: &Sampling,
-) -> Result<Vec<RunSpec>, ConfigError> {
+) -> Result<Vec<ResolvedRun>, ConfigError> {
     run_count(space)?;
     let defaults = benchmarks::default_params(benchmark.info.params);
-    let mut runs: Vec<RunSpec> = Vec::new();
+    let mut runs: Vec<ResolvedRun> = Vec::new();
     // Run id -> its block, to refuse a run that two blocks both make.
     let mut made_by: HashMap<String, usize> = HashMap::new();
     for (b, block) in space.blocks.iter().enumerate() {
         for index in 0..block_size(block) {
             let chosen = choose(space, block, index);
             let run = resolve(experiment, benchmark, &defaults, &chosen, sampling)?;
-            if let Some(earlier) = made_by.insert(run.run_id.clone(), b) {
+            if let Some(earlier) = made_by.insert(run.spec.run_id.clone(), b) {
                 return Err(ConfigError::at(
                     block.pos,
                     "matrix",
                     format!(
                         "block {} makes the run {} again (block {} made it first)",
                         b + 1,
-                        run.run_id,
+                        run.spec.run_id,
                         earlier + 1
                     ),
                 ));
@@ -142,7 +143,7 @@ fn resolve(
     defaults: &Params,
     chosen: &[Chosen],
     sampling: &Sampling,
-) -> Result<RunSpec, ConfigError> {
+) -> Result<ResolvedRun, ConfigError> {
     let mut params = defaults.clone();
     // Without a preset, the method is the one the run's parts compose (`require_given`
     // checked that a simulation without one names them all).
@@ -170,21 +171,25 @@ fn resolve(
             .filter(|m| reference::unsupported(m, benchmark.info.name).is_none());
         return Err(check_error(error, benchmark, &params, chosen).with_valid(valid));
     }
-    if let Some(error) = placement_conflict(&method, &params) {
-        return Err(check_error(error, benchmark, &params, chosen));
-    }
     (benchmark.info.check)(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
     if benchmark.info.kind.steps() {
-        check_method_params(&method, benchmark, &params)
+        refuse_reference_params(&method, &params)
             .map_err(|e| check_error(e, benchmark, &params, chosen))?;
     }
+    let run_method = RunMethod::resolve(&method, benchmark.info, &params)
+        .map_err(|e| check_error(e, benchmark, &params, chosen))?;
+    if let Some(error) = placement_conflict(&method, &run_method, &params) {
+        return Err(check_error(error, benchmark, &params, chosen));
+    }
+    let mut steps = None;
     if let Some(time_step) = benchmark.info.time_step {
         let step = time_step(&params).map_err(|e| check_error(e, benchmark, &params, chosen))?;
         check_samples(step.steps, sampling, chosen)?;
+        steps = Some(step.steps);
     }
     let output_every = sampling.every;
     let body = config_body(benchmark.info.name, &method, output_every, &params);
-    Ok(RunSpec {
+    let spec = RunSpec {
         experiment: experiment.to_string(),
         run_id: run_id(&method, &id_axes, &body),
         benchmark: benchmark.info.name.to_string(),
@@ -193,19 +198,13 @@ fn resolve(
         axes,
         output_every,
         config_yaml: config_yaml(experiment, &body),
-    })
+    };
+    Ok(ResolvedRun::new(spec, benchmark.info, run_method, steps))
 }
 
-/// The method parameters of a simulation run (`gamma`, `integrator`, ...) must suit its method:
-/// `methods::resolve` says whether they do. Reference solvers take none.
-fn check_method_params(
-    method: &str,
-    benchmark: &Benchmark,
-    params: &Params,
-) -> Result<(), ParamError> {
-    if let Some(preset) = methods::PRESETS.find(method) {
-        return methods::resolve(preset, params, benchmark.info.dim()).map(drop);
-    }
+/// Reference solvers take none of the method parameters (`gamma`, `integrator`, ...), which
+/// `methods::resolve` checks for the MPM methods.
+fn refuse_reference_params(method: &str, params: &Params) -> Result<(), ParamError> {
     match methods::METHOD_PARAMS
         .iter()
         .find(|spec| params.contains_key(spec.key))
@@ -223,9 +222,9 @@ fn check_method_params(
 
 /// The particle-domain methods (GIMP, CPDI) take the sub-cells of the seed lattice as the
 /// particles' domains, which only sub-cell centres sit in the middle of.
-fn placement_conflict(method: &str, params: &Params) -> Option<ParamError> {
+fn placement_conflict(method: &str, resolved: &RunMethod, params: &Params) -> Option<ParamError> {
     let gauss = params.get(PLACEMENT_KEY) == Some(&ParamValue::Str(GAUSS_PLACEMENT.into()));
-    let domains = methods::run_shape(method, params).is_some_and(|s| s.reads_seed_domains());
+    let domains = matches!(resolved, RunMethod::Mpm(m) if m.shape.reads_seed_domains());
     (gauss && domains).then(|| {
         ParamError::new(
             PLACEMENT_KEY,
@@ -438,13 +437,13 @@ mod tests {
             .push(("k".into(), written(ParamValue::Int(4), 3, "params.k")));
         let runs = expand("toy_exp", &benchmark, &space, &sampling(7)).unwrap();
         assert_eq!(runs.len(), 2);
-        assert_eq!(runs[1].params["x"], ParamValue::Float(2.0));
-        assert_eq!(runs[1].params["k"], ParamValue::Int(4));
-        assert_eq!(runs[1].output_every, 7);
+        assert_eq!(runs[1].spec.params["x"], ParamValue::Float(2.0));
+        assert_eq!(runs[1].spec.params["k"], ParamValue::Int(4));
+        assert_eq!(runs[1].spec.output_every, 7);
         assert!(
-            runs[1].run_id.starts_with("mpm-x2.0-"),
+            runs[1].spec.run_id.starts_with("mpm-x2.0-"),
             "{}",
-            runs[1].run_id
+            runs[1].spec.run_id
         );
     }
 }

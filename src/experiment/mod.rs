@@ -10,6 +10,7 @@ mod figures;
 mod kinds;
 mod measures;
 mod reference;
+mod resolved;
 mod run_id;
 mod run_spec;
 mod select;
@@ -24,11 +25,11 @@ use std::path::{Path, PathBuf};
 use crate::benchmarks::{self, BenchmarkKind};
 use crate::output::Measures;
 use crate::params::Params;
-use crate::run_spec::RunSpec;
 
 pub use document::MAX_NAME_LEN;
 pub use error::ConfigError;
 pub use expand::{sample_count, MAX_RUNS, MAX_SAMPLES};
+pub use resolved::{ResolvedRun, RunMethod};
 pub use run_id::MAX_RUN_ID_LEN;
 pub use select::{Allowed, Selection};
 pub use values::MAX_LIST_VALUES;
@@ -116,7 +117,7 @@ pub struct Experiment {
     /// Axis values of the run the others are compared with at the final time (`reference`).
     pub reference: Option<Params>,
     /// One entry per run, in expansion order (the cartesian product, last axis fastest).
-    pub runs: Vec<RunSpec>,
+    pub runs: Vec<ResolvedRun>,
 }
 
 impl Experiment {

@@ -6,6 +6,7 @@ use crate::benchmarks::{BenchmarkInfo, BenchmarkKind};
 use crate::params::Params;
 
 use super::error::ConfigError;
+use super::resolved::ResolvedRun;
 use super::select::listed;
 use super::space::ParamSpace;
 use super::values::normalize;
@@ -78,11 +79,12 @@ pub(crate) fn read(
 /// The reference selector must pick exactly one run of the expanded matrix.
 pub(crate) fn check_unique(
     select: &Params,
-    runs: &[RunSpec],
+    runs: &[ResolvedRun],
     section: &Entry,
 ) -> Result<(), ConfigError> {
     let matching: Vec<&RunSpec> = runs
         .iter()
+        .map(|run| &run.spec)
         .filter(|run| select.iter().all(|(k, v)| run.axes.get(k) == Some(v)))
         .collect();
     if matching.len() == 1 {

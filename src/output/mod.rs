@@ -193,12 +193,9 @@ pub struct RunSummary {
     pub axes: Params,
     /// Final error norms keyed by (field, norm), e.g. ("velocity", "l2").
     pub final_norms: BTreeMap<(String, String), f64>,
-    /// The `/reconstruction` group of a reconstruction run, which its figures and tables show.
-    pub reconstruction: Option<ReconstructionRecord>,
-    /// The `/elements` group of an element-wise reconstruction run, likewise.
-    pub elements: Option<ElementRecord>,
-    /// The `/shape_functions` group of a shape-function run, likewise.
-    pub shape_functions: Option<ShapeFunctionRecord>,
+    /// The `/reconstruction`, `/elements` or `/shape_functions` group of an unstepped run,
+    /// which its figures and tables show.
+    pub unstepped: Unstepped,
     /// The l2 velocity error at every sample of a simulation run that took any.
     pub velocity_history: Option<VelocityHistory>,
     /// The `/conservation` attributes (largest relative mass and momentum errors of the run's
@@ -319,7 +316,7 @@ pub use reader::{
 pub use reconstruction::{BasisRecord, ReconstructionRecord};
 pub use record::{
     Conservation, Diagnostics, Errors, GridErrors, GridHistory, History, MethodParts,
-    ParticleTable, RunRecord,
+    ParticleTable, RunRecord, Unstepped,
 };
 pub use shape_functions::ShapeFunctionRecord;
 pub use stream::{HistoryStream, StreamShape};

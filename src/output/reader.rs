@@ -8,6 +8,7 @@ use hdf5::Group;
 use ndarray::s;
 
 use super::h5::{group, open_attr, open_dataset, read_f64, read_i64, read_str, shaped};
+use super::record::Unstepped;
 use super::{
     elements, probes, reconstruction, shape_functions, ParticleState, ProbeRecord, RunStatus,
     RunSummary, VelocityHistory, ERROR_FIELDS_WITH_GRID, GRID_VELOCITY, NORMS, SCHEMA_VERSION,
@@ -127,24 +128,32 @@ fn summary(file: &hdf5::File) -> hdf5::Result<RunSummary> {
     let status_text = read_str(file, "status")?;
     let status =
         RunStatus::parse(&status_text).ok_or_else(|| format!("unknown status '{status_text}'"))?;
-    let reconstruction = reconstruction::read(file)?;
-    let elements = elements::read(file)?;
-    let shape_functions = shape_functions::read(file)?;
-    let unstepped = match (&reconstruction, &elements, &shape_functions) {
-        (Some(r), _, _) => Some(unstepped_norms(
+    let unstepped = if let Some(r) = reconstruction::read(file)? {
+        Unstepped::Reconstruction(r)
+    } else if let Some(r) = elements::read(file)? {
+        Unstepped::Elements(r)
+    } else if let Some(r) = shape_functions::read(file)? {
+        Unstepped::ShapeFunctions(r)
+    } else {
+        Unstepped::None
+    };
+    let unstepped_norms = match &unstepped {
+        Unstepped::Reconstruction(r) => Some(unstepped_norms(
             &RECONSTRUCTION_FIELDS,
             &RECONSTRUCTION_NORMS,
             &[r.l2, r.max],
         )),
-        (None, Some(r), _) => Some(unstepped_norms(
+        Unstepped::Elements(r) => Some(unstepped_norms(
             &RECONSTRUCTION_FIELDS,
             &ELEMENT_NORMS,
             &[r.rms, r.integral_error],
         )),
-        (None, None, Some(r)) => Some(unstepped_norms(&SHAPE_FIELDS, &SHAPE_NORMS, &r.max_errors)),
-        (None, None, None) => None,
+        Unstepped::ShapeFunctions(r) => {
+            Some(unstepped_norms(&SHAPE_FIELDS, &SHAPE_NORMS, &r.max_errors))
+        }
+        Unstepped::None => None,
     };
-    let (final_norms, steps, dt, velocity_history) = match unstepped {
+    let (final_norms, steps, dt, velocity_history) = match unstepped_norms {
         Some(norms) => (norms, 0, f64::NAN, None),
         None => (
             simulation_norms(file)?,
@@ -176,9 +185,7 @@ fn summary(file: &hdf5::File) -> hdf5::Result<RunSummary> {
         },
         axes: read_params(&matrix)?,
         final_norms,
-        reconstruction,
-        elements,
-        shape_functions,
+        unstepped,
         velocity_history,
         max_mass_error: conservation_attr(file, "max_mass_error"),
         max_momentum_error: conservation_attr(file, "max_momentum_error"),

@@ -31,16 +31,50 @@ pub struct RunRecord {
     pub diagnostics: Diagnostics,
     /// `/probes`: every-step records at single particles (none for reference solvers).
     pub probes: Vec<ProbeRecord>,
-    /// Set for the runs of reconstruction benchmarks, which have no particles or history.
-    pub reconstruction: Option<ReconstructionRecord>,
-    /// Set instead for the runs of the element-wise reconstruction benchmark.
-    pub elements: Option<ElementRecord>,
-    /// Set instead for the runs of the shape-function benchmark.
-    pub shape_functions: Option<ShapeFunctionRecord>,
+    /// What a run of a benchmark that does not step records in place of particles and a
+    /// history.
+    pub unstepped: Unstepped,
     /// The arrays of `history`, `grid`, `errors` and `probes` that grow with the samples and
     /// steps, when the run wrote them to its file as it went (those vectors then hold none),
     /// or why writing them failed.
     pub stream: Option<Result<HistoryStream, String>>,
+}
+
+/// The record of an unstepped run by its benchmark's kind; `None` for a stepped run, whose
+/// record is its particles and history.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Unstepped {
+    #[default]
+    None,
+    /// `/reconstruction`: a nodal reconstruction.
+    Reconstruction(ReconstructionRecord),
+    /// `/elements`: the element-wise reconstruction.
+    Elements(ElementRecord),
+    /// `/shape_functions`: a grid basis evaluated on a lattice.
+    ShapeFunctions(ShapeFunctionRecord),
+}
+
+impl Unstepped {
+    pub fn reconstruction(&self) -> Option<&ReconstructionRecord> {
+        match self {
+            Unstepped::Reconstruction(record) => Some(record),
+            _ => None,
+        }
+    }
+
+    pub fn elements(&self) -> Option<&ElementRecord> {
+        match self {
+            Unstepped::Elements(record) => Some(record),
+            _ => None,
+        }
+    }
+
+    pub fn shape_functions(&self) -> Option<&ShapeFunctionRecord> {
+        match self {
+            Unstepped::ShapeFunctions(record) => Some(record),
+            _ => None,
+        }
+    }
 }
 
 /// The root attributes `shape`, `transfer` and `integrator`: what the run's method is made of.

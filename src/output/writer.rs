@@ -3,6 +3,7 @@ use std::path::Path;
 use hdf5::Group;
 
 use super::h5::{attr_f64, attr_i64, attr_str, dataset, string_dataset};
+use super::record::Unstepped;
 use super::stream::{HistoryStream, StreamShape};
 use super::{
     elements, field_unit, probes, reconstruction, shape_functions, RunRecord, CONFIG_YAML,
@@ -25,16 +26,14 @@ pub fn write_record(
     stream: Option<HistoryStream>,
 ) -> hdf5::Result<()> {
     write_identity(file, r)?;
-    if let Some(record) = &r.reconstruction {
-        reconstruction::write(file, record)?;
-        return file.flush();
-    }
-    if let Some(record) = &r.elements {
-        elements::write(file, record)?;
-        return file.flush();
-    }
-    if let Some(record) = &r.shape_functions {
-        shape_functions::write(file, record)?;
+    let unstepped = match &r.unstepped {
+        Unstepped::Reconstruction(record) => Some(reconstruction::write(file, record)),
+        Unstepped::Elements(record) => Some(elements::write(file, record)),
+        Unstepped::ShapeFunctions(record) => Some(shape_functions::write(file, record)),
+        Unstepped::None => None,
+    };
+    if let Some(written) = unstepped {
+        written?;
         return file.flush();
     }
     let d = r.dim;

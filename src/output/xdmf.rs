@@ -7,7 +7,7 @@
 use std::io;
 use std::path::{Path, PathBuf};
 
-use super::{write_atomically, RunRecord, ERROR_FIELDS};
+use super::{write_atomically, RunRecord, Unstepped, ERROR_FIELDS};
 
 /// What a description needs to know of a run file: the shape of its per-sample datasets and
 /// the sample times.
@@ -23,10 +23,7 @@ impl HistoryLayout {
     /// `None` for a run without a particle history: an unstepped run, or one that failed
     /// before its first sample.
     pub fn of(record: &RunRecord) -> Option<HistoryLayout> {
-        let unstepped = record.reconstruction.is_some()
-            || record.elements.is_some()
-            || record.shape_functions.is_some();
-        if unstepped {
+        if !matches!(record.unstepped, Unstepped::None) {
             return None;
         }
         HistoryLayout {

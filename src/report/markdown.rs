@@ -180,7 +180,7 @@ fn consistency_table(md: &mut String, experiment: &Experiment, runs: &[&RunSumma
     header.extend(SHAPE_FIELDS.map(String::from));
     header.extend(["Newton failures", "most Newton steps"].map(String::from));
     let rows = runs.iter().filter_map(|run| {
-        let record = run.shape_functions.as_ref()?;
+        let record = run.unstepped.shape_functions()?;
         let mut row = vec![format!("`{}`", run.run_id)];
         row.extend(group::axis_values(experiment, run));
         row.extend(record.max_errors.map(|e| general(e, 3)));

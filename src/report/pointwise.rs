@@ -41,14 +41,19 @@ fn nodal_errors<'a>(
     spec: &TableSpec,
 ) -> Vec<Table> {
     let column_axis = spec.columns.as_deref().unwrap_or_default();
-    let order = |run: &RunSummary| experiment.runs.iter().position(|r| r.run_id == run.run_id);
+    let order = |run: &RunSummary| {
+        experiment
+            .runs
+            .iter()
+            .position(|r| r.spec.run_id == run.run_id)
+    };
     group_runs(runs, &[column_axis])
         .into_iter()
         .filter_map(|group| {
             let mut columns: Vec<(&RunSummary, &ReconstructionRecord)> = group
                 .runs
                 .iter()
-                .filter_map(|run| Some((*run, run.reconstruction.as_ref()?)))
+                .filter_map(|run| Some((*run, run.unstepped.reconstruction()?)))
                 .collect();
             columns.sort_by_key(|(run, _)| order(run));
             let nodes = columns.iter().map(|(_, r)| r.error.len()).max()?;
@@ -83,7 +88,7 @@ fn nodal_errors<'a>(
 fn basis_norms<'a>(runs: impl Iterator<Item = &'a RunSummary>) -> Option<Table> {
     let rows: Vec<(&RunSummary, &ReconstructionRecord)> = runs
         .filter_map(|run| {
-            let record = run.reconstruction.as_ref()?;
+            let record = run.unstepped.reconstruction()?;
             record.basis.as_ref().map(|_| (run, record))
         })
         .collect();
@@ -128,9 +133,14 @@ fn element_fits<'a>(
     experiment: &Experiment,
     runs: impl Iterator<Item = &'a RunSummary>,
 ) -> Option<Table> {
-    let order = |run: &RunSummary| experiment.runs.iter().position(|r| r.run_id == run.run_id);
+    let order = |run: &RunSummary| {
+        experiment
+            .runs
+            .iter()
+            .position(|r| r.spec.run_id == run.run_id)
+    };
     let mut rows: Vec<(&RunSummary, &ElementRecord)> = runs
-        .filter_map(|run| Some((run, run.elements.as_ref()?)))
+        .filter_map(|run| Some((run, run.unstepped.elements()?)))
         .collect();
     if rows.is_empty() {
         return None;

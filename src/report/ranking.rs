@@ -4,6 +4,7 @@
 //! changes with every rerun and machine and so stays out of the committed results.
 
 use std::cmp::Ordering;
+use std::collections::HashMap;
 use std::fmt::Write;
 
 use super::format::general;
@@ -131,7 +132,11 @@ pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> 
             continue;
         };
         let selected = ordered_runs(runs.iter().filter(|run| selects(&spec.select, &run.axes)));
-        let error_rank = rank(&selected, |run| ranked_error(run, field, norm));
+        let error_rank: HashMap<&str, Option<usize>> =
+            rank(&selected, |run| ranked_error(run, field, norm))
+                .into_iter()
+                .map(|(rank, run)| (run.run_id.as_str(), rank))
+                .collect();
         let by_time = rank(&selected, |run| {
             let seconds = stepping_seconds(run);
             (run.status == RunStatus::Ok && seconds.is_finite()).then_some(seconds)
@@ -148,10 +153,7 @@ pub fn costs_md(experiment: &Experiment, runs: &[RunSummary]) -> Option<String> 
             format!("rank by {norm} {field} error"),
         ];
         let (mut header, rows) = per_run_rows(experiment, &in_order, columns, |run| {
-            let error_rank = error_rank
-                .iter()
-                .find(|(_, r)| r.run_id == run.run_id)
-                .and_then(|(rank, _)| *rank);
+            let error_rank = error_rank.get(run.run_id.as_str()).copied().flatten();
             let seconds = stepping_seconds(run);
             vec![
                 general(seconds, 3),

@@ -259,7 +259,7 @@ pub fn group_name(axes: &Params) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::VelocityHistory;
+    use crate::output::{Unstepped, VelocityHistory};
     use std::collections::BTreeMap;
 
     fn run(cfl: f64, status: RunStatus, errors: &[f64]) -> RunSummary {
@@ -280,9 +280,7 @@ mod tests {
             step_seconds: f64::NAN,
             axes: Params::from([("cfl".to_string(), ParamValue::Float(cfl))]),
             final_norms: BTreeMap::new(),
-            reconstruction: None,
-            elements: None,
-            shape_functions: None,
+            unstepped: Unstepped::None,
             velocity_history: Some(VelocityHistory {
                 time: (0..errors.len()).map(|k| k as f64).collect(),
                 l2_error: errors.to_vec(),

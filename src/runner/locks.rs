@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use super::needs_run;
+use crate::experiment::ResolvedRun;
 use crate::output::{run_path, this_host, TempHost, TempWriter};
-use crate::run_spec::RunSpec;
 
 fn lock_path(dir: &Path, run_id: &str) -> PathBuf {
     dir.join("runs").join(format!(".{run_id}.lock"))
@@ -86,7 +86,7 @@ pub struct Claims<'a> {
     force: bool,
     held: Mutex<HashMap<String, RunLock>>,
     /// Runs whose lock another process holds.
-    busy: Mutex<Vec<&'a RunSpec>>,
+    busy: Mutex<Vec<&'a ResolvedRun>>,
     /// Runs whose file another process wrote while this one ran.
     elsewhere: Mutex<usize>,
 }
@@ -96,7 +96,7 @@ pub struct Waited<'a> {
     /// Written by the other process.
     pub elsewhere: usize,
     /// Not written: their holder ended first, and this process computes them in another pass.
-    pub orphans: Vec<&'a RunSpec>,
+    pub orphans: Vec<&'a ResolvedRun>,
 }
 
 impl<'a> Claims<'a> {
@@ -113,15 +113,15 @@ impl<'a> Claims<'a> {
     /// Whether this process computes `run`: it took the run's lock, and the run still needs
     /// computing (`needs_run`). A lock that cannot be taken at all leaves the run to this process,
     /// unlocked; writing it then reports what is wrong with the directory.
-    pub fn take(&self, run: &'a RunSpec) -> bool {
-        match claim(&self.dir, &run.run_id, false) {
+    pub fn take(&self, run: &'a ResolvedRun) -> bool {
+        match claim(&self.dir, &run.spec.run_id, false) {
             Ok(Claim::Held(lock)) => {
                 // Another process may have written it since this one looked.
-                if !needs_run(&self.dir, &run.run_id, self.force) {
+                if !needs_run(&self.dir, &run.spec.run_id, self.force) {
                     *lock_of(&self.elsewhere) += 1;
                     return false;
                 }
-                lock_of(&self.held).insert(run.run_id.clone(), lock);
+                lock_of(&self.held).insert(run.spec.run_id.clone(), lock);
                 true
             }
             Ok(Claim::Busy) => {
@@ -149,17 +149,17 @@ impl<'a> Claims<'a> {
         };
         if let Some(first) = busy.first() {
             let holder =
-                fs::read_to_string(lock_path(&self.dir, &first.run_id)).unwrap_or_default();
+                fs::read_to_string(lock_path(&self.dir, &first.spec.run_id)).unwrap_or_default();
             eprintln!(
                 "{name}: waiting for {} run(s) another process is computing (e.g. {}, held by {})",
                 busy.len(),
-                first.run_id,
+                first.spec.run_id,
                 holder.trim()
             );
         }
         for run in busy {
-            let _lock = claim(&self.dir, &run.run_id, true)?;
-            if run_path(&self.dir, &run.run_id).exists() {
+            let _lock = claim(&self.dir, &run.spec.run_id, true)?;
+            if run_path(&self.dir, &run.spec.run_id).exists() {
                 waited.elsewhere += 1;
             } else {
                 waited.orphans.push(run);

@@ -7,12 +7,11 @@
 //! chunk buffers. The history itself is on disk (`output::HistoryStream`), so the estimate
 //! does not grow with the number of samples.
 
-use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
+use super::{Job, Work};
+use crate::benchmarks::{AnyProblem, Problem};
 use crate::grid::Grid;
-use crate::methods::{self, Method};
-use crate::params::get_usize;
+use crate::methods::Method;
 use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe, TransferKind};
-use crate::run_spec::RunSpec;
 use crate::shape::{DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, Shape, ShapeKind};
 
 /// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
@@ -22,28 +21,21 @@ const FIXED_BYTES: f64 = 48.0 * 1024.0 * 1024.0;
 /// value, fit and errors.
 const UNSTEPPED_BYTES_PER_POINT: f64 = 512.0;
 
-/// The estimated peak memory of `spec` in bytes.
-pub fn estimated_bytes(spec: &RunSpec) -> f64 {
-    let info = benchmarks::CATALOG.find(&spec.benchmark);
-    let dim = info.map_or(1, |b| b.dim()) as i32;
-    let int = |key: &str| get_usize(&spec.params, key).unwrap_or(1) as f64;
-    let unstepped = info.is_none_or(|b| b.kind != BenchmarkKind::Simulation);
-    let body_particles = (int("cells") * int("ppc")).powi(dim);
-    if unstepped || crate::reference::METHODS.find(&spec.method).is_some() {
-        return FIXED_BYTES + body_particles * UNSTEPPED_BYTES_PER_POINT;
-    }
-    let method = methods::PRESETS
-        .find(&spec.method)
-        .and_then(|preset| methods::resolve(preset, &spec.params, dim as usize).ok());
-    let (Some(method), Ok(problem)) = (method, benchmarks::build(&spec.benchmark, &spec.params))
-    else {
-        return FIXED_BYTES;
-    };
-    let ppc = int("ppc");
+/// The estimated peak memory of `job` in bytes.
+pub(super) fn estimated_bytes(job: &Job) -> f64 {
+    let run = job.run;
+    let (cells, ppc) = (run.cells.max(1) as f64, run.ppc.max(1) as f64);
+    let body_particles = (cells * ppc).powi(run.dim() as i32);
     FIXED_BYTES
-        + match problem {
-            AnyProblem::D1(p) => simulation_bytes(p.as_ref(), &method, body_particles, ppc),
-            AnyProblem::D2(p) => simulation_bytes(p.as_ref(), &method, body_particles, ppc),
+        + match &job.work {
+            Ok(Work::Mpm(method, AnyProblem::D1(p))) => {
+                simulation_bytes(p.as_ref(), method, body_particles, ppc)
+            }
+            Ok(Work::Mpm(method, AnyProblem::D2(p))) => {
+                simulation_bytes(p.as_ref(), method, body_particles, ppc)
+            }
+            Ok(_) => body_particles * UNSTEPPED_BYTES_PER_POINT,
+            Err(_) => 0.0,
         }
 }
 

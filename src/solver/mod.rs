@@ -13,74 +13,93 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
-use crate::benchmarks::{self, AnyProblem, BenchmarkKind, Problem};
+use crate::benchmarks::{AnyProblem, Problem};
 use crate::divergence::Divergence;
+use crate::experiment::{ResolvedRun, RunMethod};
 use crate::grid::{FixedDof, Grid, GridState};
 use crate::integrate::predictor_corrector::PredictorCorrector;
 use crate::integrate::{self, leapfrog, musl, IntegratorKind};
 use crate::methods::{self, Method};
-use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus};
+use crate::output::{Diagnostics, MethodParts, ParticleTable, RunRecord, RunStatus, Unstepped};
 use crate::parallel;
 use crate::particles::Particles;
 use crate::reconstruct::{nodal_forces, FitStats};
-use crate::run_spec::RunSpec;
+use crate::reconstruction_methods::ReconstructionMethod;
 use crate::shape::ShapeKind;
 use crate::shape::{
     DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, Shape, SplineDegree, Stencils,
 };
+use crate::shape_methods::ShapeMethod;
 
-pub use footprint::estimated_bytes;
 use recorder::{GridSample, Recorder};
 use transfer::Transfer;
 
 /// Runs one configuration, keeping its whole history in the record. Never panics on bad
 /// numbers: a run that cannot start is `failed`, a run that blows up is `diverged`, each with
 /// the reason in `message`.
-pub fn simulate(spec: &RunSpec) -> RunRecord {
-    simulate_with(spec, None)
+pub fn simulate(run: &ResolvedRun) -> RunRecord {
+    Job::new(run).compute(None)
 }
 
-/// The same, streaming the history of a simulation into `file` as it is sampled (the
-/// record's `stream`), so that its memory does not grow with the samples; `write_record`
-/// completes the file.
-pub fn simulate_into(spec: &RunSpec, file: &hdf5::File) -> RunRecord {
-    simulate_with(spec, Some(file))
+/// A run ready to compute: what its method works on, built once, so that the runner can weigh
+/// its memory (`estimated_bytes`) before it starts.
+pub struct Job<'a> {
+    run: &'a ResolvedRun,
+    /// What the run computes, or why it cannot start.
+    work: Result<Work, String>,
 }
 
-fn simulate_with(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
-    let started = Instant::now();
-    let kind = benchmarks::CATALOG.find(&spec.benchmark).map(|b| b.kind);
-    let mut record = if kind.is_some_and(BenchmarkKind::is_reconstruction) {
-        reconstruction::evaluate(spec)
-    } else if kind == Some(BenchmarkKind::ShapeFunctions) {
-        shape_functions::evaluate(spec)
-    } else if crate::reference::METHODS.find(&spec.method).is_some() {
-        reference::solve(spec, file)
-    } else {
-        step(spec, file)
-    };
-    record.wall_seconds = started.elapsed().as_secs_f64();
-    record
+/// The problem of a stepped run with what steps it; the method of a run that does not step.
+enum Work {
+    Mpm(Method, AnyProblem),
+    Reference(AnyProblem),
+    Reconstruction(&'static ReconstructionMethod),
+    Basis(&'static ShapeMethod),
 }
 
-/// A simulation: the problem stepped to its final time by the method.
-fn step(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
-    match prepare(spec) {
-        Ok((method, AnyProblem::D1(problem))) => Run::new(spec, method, problem, file).execute(),
-        Ok((method, AnyProblem::D2(problem))) => Run::new(spec, method, problem, file).execute(),
-        Err(message) => base_record(spec, message),
+impl<'a> Job<'a> {
+    /// Builds the problem of a stepped run; the problem seeds no particles until it runs.
+    pub fn new(run: &'a ResolvedRun) -> Self {
+        let problem = || {
+            run.benchmark
+                .problem(&run.spec.params)
+                .map_err(|e| e.to_string())
+        };
+        let work = match run.method {
+            RunMethod::Mpm(method) => problem().map(|p| Work::Mpm(method, p)),
+            RunMethod::Reference(_) => problem().map(Work::Reference),
+            RunMethod::Reconstruction(method) => Ok(Work::Reconstruction(method)),
+            RunMethod::Basis(method) => Ok(Work::Basis(method)),
+        };
+        Job { run, work }
     }
-}
 
-fn prepare(spec: &RunSpec) -> Result<(Method, AnyProblem), String> {
-    let preset = methods::PRESETS.get(&spec.method)?;
-    let problem = benchmarks::build(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
-    let dim = match problem {
-        AnyProblem::D1(_) => 1,
-        AnyProblem::D2(_) => 2,
-    };
-    let method = methods::resolve(preset, &spec.params, dim).map_err(|e| e.to_string())?;
-    Ok((method, problem))
+    /// The run's estimated peak memory in bytes (`footprint`).
+    pub fn estimated_bytes(&self) -> f64 {
+        footprint::estimated_bytes(self)
+    }
+
+    /// Computes the run; with a `file`, the history of a stepped run is streamed into it as it
+    /// is sampled (the record's `stream`), so that its memory does not grow with the samples,
+    /// and `write_record` completes the file.
+    pub fn compute(self, file: Option<&hdf5::File>) -> RunRecord {
+        let started = Instant::now();
+        let run = self.run;
+        let mut record = match self.work {
+            Ok(Work::Mpm(method, AnyProblem::D1(problem))) => {
+                Run::new(run, method, problem, file).execute()
+            }
+            Ok(Work::Mpm(method, AnyProblem::D2(problem))) => {
+                Run::new(run, method, problem, file).execute()
+            }
+            Ok(Work::Reference(problem)) => reference::solve(run, problem, file),
+            Ok(Work::Reconstruction(method)) => reconstruction::evaluate(run, method),
+            Ok(Work::Basis(method)) => shape_functions::evaluate(run, method),
+            Err(message) => base_record(run, message),
+        };
+        record.wall_seconds = started.elapsed().as_secs_f64();
+        record
+    }
 }
 
 /// The grid basis of a run as the particles see it.
@@ -121,7 +140,7 @@ impl<const D: usize> Basis<D> {
 
 /// The state of one run in progress.
 struct Run<'a, const D: usize> {
-    spec: &'a RunSpec,
+    resolved: &'a ResolvedRun,
     method: Method,
     problem: Box<dyn Problem<D>>,
     basis: Basis<D>,
@@ -148,7 +167,7 @@ struct Run<'a, const D: usize> {
 
 impl<'a, const D: usize> Run<'a, D> {
     fn new(
-        spec: &'a RunSpec,
+        resolved: &'a ResolvedRun,
         method: Method,
         mut problem: Box<dyn Problem<D>>,
         file: Option<&hdf5::File>,
@@ -161,7 +180,12 @@ impl<'a, const D: usize> Run<'a, D> {
         recorder.attach_probes(problem.as_ref(), &particles.x0);
         recorder.attach_grid(&grid);
         if let Some(file) = file {
-            recorder.stream_to(file, particles.len(), problem.steps(), spec.output_every);
+            recorder.stream_to(
+                file,
+                particles.len(),
+                problem.steps(),
+                resolved.spec.output_every,
+            );
         }
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
@@ -184,7 +208,7 @@ impl<'a, const D: usize> Run<'a, D> {
             shape => footprint::stencil_nodes::<D>(shape),
         };
         Run {
-            spec,
+            resolved,
             method,
             stencils: Stencils::new(per_point, n),
             transfer: Transfer::new(&method.transfer, &grid, basis.shape(), &fixed),
@@ -208,7 +232,7 @@ impl<'a, const D: usize> Run<'a, D> {
     fn execute(mut self) -> RunRecord {
         let (steps, outcome) = self.step_all();
         let mut record = stepped_record(
-            self.spec,
+            self.resolved,
             Stepped {
                 parts: self.method.into(),
                 h: self.grid.h,
@@ -250,7 +274,7 @@ impl<'a, const D: usize> Run<'a, D> {
     fn step_all(&mut self) -> (usize, Result<(), (usize, Divergence)>) {
         let dt = self.problem.dt();
         let steps = self.problem.steps();
-        let every = self.spec.output_every;
+        let every = self.resolved.spec.output_every;
         let mut synced = vec![SVector::zeros(); self.particles.len()];
         if let Err(reason) = self
             .locate_particles()
@@ -554,7 +578,7 @@ struct Stepped<const D: usize> {
     diagnostics: Diagnostics,
 }
 
-fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord {
+fn stepped_record<const D: usize>(resolved: &ResolvedRun, run: Stepped<D>) -> RunRecord {
     let (status, message) = match run.outcome {
         Ok(()) => (RunStatus::Ok, String::new()),
         Err((step, reason)) => (
@@ -562,7 +586,7 @@ fn stepped_record<const D: usize>(spec: &RunSpec, run: Stepped<D>) -> RunRecord 
             format!("step {step} (t = {:e}): {reason}", step as f64 * run.dt),
         ),
     };
-    let mut record = base_record(spec, message);
+    let mut record = base_record(resolved, message);
     record.parts = run.parts;
     record.dim = D;
     record.h = run.h;
@@ -612,22 +636,21 @@ fn fixed_dofs<const D: usize>(grid: &Grid<D>, faces: &[[bool; 2]; D]) -> Vec<Fix
 
 /// A record with the run's identity and status `failed` with `message`: the whole record of a
 /// run that failed before it computed anything; a run that starts fills in the rest.
-pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
-    let int = |key: &str| crate::params::get_usize(&spec.params, key).unwrap_or(0);
+pub fn base_record(run: &ResolvedRun, message: String) -> RunRecord {
+    // A run that is not MPM records the parts of the first preset until it fills in its own.
+    let method = match run.method {
+        RunMethod::Mpm(method) => method,
+        _ => methods::PRESETS.entries[0].method,
+    };
     RunRecord {
-        spec: spec.clone(),
-        parts: methods::PRESETS
-            .find(&spec.method)
-            .map_or(methods::PRESETS.entries[0].method, |p| p.method)
-            .into(),
-        dim: benchmarks::CATALOG
-            .find(&spec.benchmark)
-            .map_or(0, |b| b.dim()),
-        cells: int("cells"),
-        ppc: int("ppc"),
+        spec: run.spec.clone(),
+        parts: method.into(),
+        dim: run.dim(),
+        cells: run.cells,
+        ppc: run.ppc,
         h: f64::NAN,
         dt: f64::NAN,
-        t_end: crate::params::get_f64(&spec.params, "t_end").unwrap_or(f64::NAN),
+        t_end: run.t_end,
         steps: 0,
         status: RunStatus::Failed,
         message,
@@ -640,9 +663,7 @@ pub fn base_record(spec: &RunSpec, message: String) -> RunRecord {
         conservation: Default::default(),
         diagnostics: Default::default(),
         probes: Vec::new(),
-        reconstruction: None,
-        elements: None,
-        shape_functions: None,
+        unstepped: Unstepped::None,
         stream: None,
     }
 }
@@ -652,6 +673,14 @@ mod tests {
     use super::*;
     use nalgebra::SMatrix;
     use std::path::Path;
+
+    /// The run of `resolved`, a 1D MPM run, ready to step.
+    fn one_dimensional_run(resolved: &ResolvedRun) -> Run<'_, 1> {
+        match Job::new(resolved).work.unwrap() {
+            Work::Mpm(method, AnyProblem::D1(problem)) => Run::new(resolved, method, problem, None),
+            _ => unreachable!("a 1D MPM run"),
+        }
+    }
 
     /// Steps 1-2 of a step at time `t`: locate, the stencils, the body force, the mapping and
     /// the grid solve with a whole kick dt.
@@ -681,12 +710,7 @@ mod tests {
              cells: 4, ppc: 2, dt: 1.0e-4, t_end: 0.02}}\n"
         );
         let exp = crate::experiment::parse(&text, Path::new("t.yaml")).unwrap();
-        let spec = &exp.runs[0];
-        let (method, problem) = match prepare(spec).unwrap() {
-            (method, AnyProblem::D1(problem)) => (method, problem),
-            _ => unreachable!("mms1d_tran is 1D"),
-        };
-        let mut run = Run::new(spec, method, problem, None);
+        let mut run = one_dimensional_run(&exp.runs[0]);
         let dt = run.problem.dt();
         let grid_solve = |run: &mut Run<1>, s: usize| grid_step(run, s as f64 * dt, dt);
         // At t = 0 the stress and the body force vanish, so every integrator agrees; the
@@ -747,12 +771,8 @@ mod tests {
                  dt: 1.0e-4, t_end: 1.0e-2}}\n"
             );
             let exp = crate::experiment::parse(&text, Path::new("t.yaml")).unwrap();
-            let spec = &exp.runs[0];
-            let (method, problem) = match prepare(spec).unwrap() {
-                (method, AnyProblem::D1(problem)) => (method, problem),
-                _ => unreachable!("the vibrating bar is 1D"),
-            };
-            let mut run = Run::new(spec, method, problem, None);
+            let mut run = one_dimensional_run(&exp.runs[0]);
+            let method = run.method;
             // The grid [0, 1] with the body shrunk to its middle, free at both ends.
             run.fixed.clear();
             run.transfer = Transfer::new(&method.transfer, &run.grid, run.basis.shape(), &[]);

@@ -5,28 +5,28 @@ use nalgebra::SVector;
 
 use super::recorder::{GridSample, Recorder};
 use super::{base_record, stepped_record, Stepped};
-use crate::benchmarks::{self, AnyProblem, Problem};
+use crate::benchmarks::{AnyProblem, Problem};
+use crate::experiment::ResolvedRun;
 use crate::output::{MethodParts, RunRecord};
-use crate::reference::{self, UlFem};
-use crate::run_spec::RunSpec;
+use crate::reference::UlFem;
 
-/// Runs `spec`, whose method is a reference method; a benchmark it does not solve makes the
-/// run `failed` with the reason.
-pub(super) fn solve(spec: &RunSpec, file: Option<&hdf5::File>) -> RunRecord {
-    if let Some(reason) = reference::unsupported(&spec.method, &spec.benchmark) {
-        return base_record(spec, reason);
-    }
-    match benchmarks::build(&spec.benchmark, &spec.params) {
-        Ok(AnyProblem::D1(problem)) => ulfem(spec, problem.as_ref(), file),
-        Ok(AnyProblem::D2(_)) => base_record(spec, format!("{} is 1D only", spec.method)),
-        Err(e) => base_record(spec, e.to_string()),
+/// Runs `run`, whose method is a reference solver (expansion has checked that it solves the
+/// run's benchmark), on its `problem`.
+pub(super) fn solve(
+    run: &ResolvedRun,
+    problem: AnyProblem,
+    file: Option<&hdf5::File>,
+) -> RunRecord {
+    match problem {
+        AnyProblem::D1(problem) => ulfem(run, problem.as_ref(), file),
+        AnyProblem::D2(_) => base_record(run, format!("{} is 1D only", run.spec.method)),
     }
 }
 
-fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>, file: Option<&hdf5::File>) -> RunRecord {
+fn ulfem(run: &ResolvedRun, problem: &dyn Problem<1>, file: Option<&hdf5::File>) -> RunRecord {
     let dt = problem.dt();
     let planned = problem.steps();
-    let every = spec.output_every;
+    let every = run.spec.output_every;
     let mut fem = UlFem::new(problem);
     let mut recorder = Recorder::new();
     if let Some(file) = file {
@@ -61,7 +61,7 @@ fn ulfem(spec: &RunSpec, problem: &dyn Problem<1>, file: Option<&hdf5::File>) ->
     }
     let h = problem.domain().upper[0] - problem.domain().lower[0];
     let mut record = stepped_record(
-        spec,
+        run,
         Stepped {
             parts: MethodParts {
                 shape: "linear finite element".into(),

@@ -7,11 +7,11 @@ use nalgebra::{SMatrix, SVector};
 use super::base_record;
 use super::reconstruction::nan_max;
 use crate::benchmarks::shape_functions::ShapeProblem;
+use crate::experiment::ResolvedRun;
 use crate::grid::{lattice_coords, Dofs, Grid};
-use crate::output::{RunRecord, RunStatus, ShapeFunctionRecord};
-use crate::run_spec::RunSpec;
+use crate::output::{RunRecord, RunStatus, ShapeFunctionRecord, Unstepped};
 use crate::shape::{LinearHat, LmeFailure, LocalMaxEnt, Shape, SplineDegree};
-use crate::shape_methods::{self, Basis};
+use crate::shape_methods::{Basis, ShapeMethod};
 
 /// Neighbours of the centre node recorded on each side along x.
 const NEIGHBOURS: usize = 2;
@@ -19,16 +19,18 @@ const NEIGHBOURS: usize = 2;
 /// Runs one configuration. A run whose basis cannot be built is `failed` with the reason in
 /// `message`; so is a run where Newton stopped short at some LME point, with the numbers of
 /// every point still recorded.
-pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
-    let mut record = base_record(spec, String::new());
-    let evaluated = prepare(spec).and_then(|(basis, problem)| {
-        record.dim = problem.dim;
-        record.h = 1.0;
-        match problem.dim {
-            1 => tabulate::<1>(&problem, basis),
-            _ => tabulate::<2>(&problem, basis),
-        }
-    });
+pub(super) fn evaluate(run: &ResolvedRun, method: &ShapeMethod) -> RunRecord {
+    let mut record = base_record(run, String::new());
+    let evaluated = ShapeProblem::from_params(&run.spec.params)
+        .map_err(|e| e.to_string())
+        .and_then(|problem| {
+            record.dim = problem.dim;
+            record.h = 1.0;
+            match problem.dim {
+                1 => tabulate::<1>(&problem, method.basis),
+                _ => tabulate::<2>(&problem, method.basis),
+            }
+        });
     match evaluated {
         Ok(out) if out.failures > 0 => {
             record.message = format!(
@@ -36,15 +38,15 @@ pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
                 out.failures,
                 out.point_count()
             );
-            record.shape_functions = Some(out);
+            record.unstepped = Unstepped::ShapeFunctions(out);
         }
         Ok(out) => {
             record.status = RunStatus::Ok;
-            record.shape_functions = Some(out);
+            record.unstepped = Unstepped::ShapeFunctions(out);
         }
         Err(message) => {
             record.message = message;
-            record.shape_functions = Some(ShapeFunctionRecord {
+            record.unstepped = Unstepped::ShapeFunctions(ShapeFunctionRecord {
                 gamma: f64::NAN,
                 tolerance: f64::NAN,
                 radius: f64::NAN,
@@ -54,18 +56,6 @@ pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
         }
     }
     record
-}
-
-fn prepare(spec: &RunSpec) -> Result<(Basis, ShapeProblem), String> {
-    let method = shape_methods::METHODS.find(&spec.method).ok_or_else(|| {
-        format!(
-            "unknown basis '{}'; valid: {}",
-            spec.method,
-            shape_methods::METHODS.names().join(", ")
-        )
-    })?;
-    let problem = ShapeProblem::from_params(&spec.params).map_err(|e| e.to_string())?;
-    Ok((method.basis, problem))
 }
 
 /// A basis of the catalogue in `D` dimensions.

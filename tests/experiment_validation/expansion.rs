@@ -94,7 +94,12 @@ fn valid_file_expands_in_order_with_stable_ids() {
     let order: Vec<(String, String)> = exp
         .runs
         .iter()
-        .map(|r| (r.axes["G"].to_string(), r.axes["cells"].to_string()))
+        .map(|r| {
+            (
+                r.spec.axes["G"].to_string(),
+                r.spec.axes["cells"].to_string(),
+            )
+        })
         .collect();
     let expected: Vec<(String, String)> = ["0.0001", "0.1"]
         .iter()
@@ -103,20 +108,24 @@ fn valid_file_expands_in_order_with_stable_ids() {
     assert_eq!(order, expected, "last axis varies fastest");
 
     let run = &exp.runs[0];
-    assert_eq!((run.method.as_str(), run.output_every), ("mpm", 10));
-    assert_eq!(run.params["G"], ParamValue::Float(1e-4));
-    assert_eq!(run.params["cells"], ParamValue::Int(8));
-    assert!(!run.params.contains_key("method"));
+    assert_eq!(
+        (run.spec.method.as_str(), run.spec.output_every),
+        ("mpm", 10)
+    );
+    assert_eq!(run.spec.params["G"], ParamValue::Float(1e-4));
+    assert_eq!(run.spec.params["cells"], ParamValue::Int(8));
+    assert!(!run.spec.params.contains_key("method"));
     assert!(run
+        .spec
         .config_yaml
         .starts_with("experiment: gong_mpm_1d\nbenchmark: mms1d_gong\n"));
-    let (prefix, hash) = run.run_id.rsplit_once('-').unwrap();
+    let (prefix, hash) = run.spec.run_id.rsplit_once('-').unwrap();
     assert_eq!(prefix, "mpm-G0.0001-cells8");
     assert!(
         hash.len() == 12 && hash.chars().all(|c| c.is_ascii_hexdigit()),
         "{hash}"
     );
-    let unique: HashSet<&str> = exp.runs.iter().map(|r| r.run_id.as_str()).collect();
+    let unique: HashSet<&str> = exp.runs.iter().map(|r| r.spec.run_id.as_str()).collect();
     assert_eq!(unique.len(), exp.runs.len());
 
     assert_eq!(exp.expect.len(), 2);
@@ -145,11 +154,16 @@ fn defaults_fill_what_the_file_leaves_out() {
         ("t_end", 0.02),
         ("cfl", 0.4),
     ] {
-        assert_eq!(run.params[key], ParamValue::Float(value), "{key}");
+        assert_eq!(run.spec.params[key], ParamValue::Float(value), "{key}");
     }
     assert_eq!(exp.output.every, 0);
-    assert_eq!(run.axes["method"], ParamValue::Str("mpm".into()));
-    assert_eq!(run.run_id.matches("mpm").count(), 1, "{}", run.run_id);
+    assert_eq!(run.spec.axes["method"], ParamValue::Str("mpm".into()));
+    assert_eq!(
+        run.spec.run_id.matches("mpm").count(),
+        1,
+        "{}",
+        run.spec.run_id
+    );
     assert_eq!(
         exp.figures[0].fields,
         [
@@ -206,7 +220,7 @@ fn ids(text: &str) -> Vec<String> {
         .unwrap()
         .runs
         .into_iter()
-        .map(|r| r.run_id)
+        .map(|r| r.spec.run_id)
         .collect()
 }
 
@@ -236,11 +250,11 @@ fn runs_describe_themselves() {
     let exp = parse(VALID).unwrap();
     let run = &exp.runs[5];
     assert_eq!(
-        run.describe(),
-        format!("{}  mms1d_gong mpm G=0.1 cells=8", run.run_id)
+        run.spec.describe(),
+        format!("{}  mms1d_gong mpm G=0.1 cells=8", run.spec.run_id)
     );
-    let json = run.to_json();
-    assert_eq!(json["run_id"], run.run_id.as_str());
+    let json = run.spec.to_json();
+    assert_eq!(json["run_id"], run.spec.run_id.as_str());
     assert_eq!(json["params"]["cells"], 8);
     assert_eq!(json["axes"]["G"], 0.1);
     assert_eq!(json["output_every"], 10);

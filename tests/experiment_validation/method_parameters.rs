@@ -18,8 +18,12 @@ fn method_parameters_are_axes_that_blocks_may_leave_out() {
     let exp = parse(LME).unwrap();
     assert_eq!(exp.runs.len(), 8);
     assert_eq!(exp.axes, ["method", "integrator", "cells", "gamma"]);
-    let mpm = exp.runs.iter().find(|r| r.method == "mpm").unwrap();
-    assert!(!mpm.params.contains_key("gamma"), "{:?}", mpm.params);
+    let mpm = exp.runs.iter().find(|r| r.spec.method == "mpm").unwrap();
+    assert!(
+        !mpm.spec.params.contains_key("gamma"),
+        "{:?}",
+        mpm.spec.params
+    );
     // Other axes must still agree between blocks.
     let e = error(&LME.replace(
         "integrator: [predictor_corrector], cells",

@@ -9,19 +9,25 @@ fn matrix_blocks_expand_in_order_without_repeats() {
     assert_eq!(exp.axes, ["method", "spacing", "cells"]);
     assert_eq!(exp.runs.len(), 1 + 2 * 2 * 3);
     assert!(exp.runs[0]
+        .spec
         .run_id
         .starts_with("mls_linear-spacingrandom-cells5-"));
     assert!(exp.runs[1]
+        .spec
         .run_id
         .starts_with("shepard-spacingequal-cells10-"));
-    assert_eq!(exp.runs[0].params["weight"], ParamValue::Str("hat".into()));
+    assert_eq!(
+        exp.runs[0].spec.params["weight"],
+        ParamValue::Str("hat".into())
+    );
     assert_eq!(exp.figures[0].kind, FigureKind::Reconstruction);
     let basis = parse(BASIS).unwrap();
     assert_eq!(
-        basis.runs[1].params["points"],
+        basis.runs[1].spec.params["points"],
         ParamValue::List(vec![-0.6, 0.4])
     );
     assert!(basis.runs[1]
+        .spec
         .run_id
         .starts_with("imls_quadratic-points-0.6_0.4-"));
 }

@@ -37,6 +37,10 @@ CONSERVING_SHAPES = (
 )
 CONSERVING_TRANSFERS = ("shepard", "consistent_mass", "tls", "tls_lumped")
 
+# Per shape part, the degree of its DOF lattice: cells + degree DOFs per axis, at the Greville
+# abscissae of that degree (1: the grid nodes).
+DOF_DEGREES = {p["name"]: p["dof_degree"] for p in METHODS["parts"]["shape"]}
+
 
 def method_parts(method, param):
     """The (shape, transfer) names of a run of `method`: the preset's, or the run's `shape`

@@ -6,7 +6,7 @@ manufactured solutions.
 import numpy as np
 import pytest
 
-from catalog import REFERENCE_METHODS, conserves
+from catalog import DOF_DEGREES, REFERENCE_METHODS, conserves, method_parts
 from layout import (
     CENTRED_INTEGRATORS, DIAGNOSTICS, FIELDS, GRID_FIELD, HALF_STEP_INTEGRATORS, MASS_UNITS,
     NORMS, RTOL_STORED, _as_str,
@@ -16,6 +16,12 @@ from manufactured import BENCHMARKS, _check_pointwise, grid_exact_velocity, sine
 
 # --------------------------------------------------------------------------------------------
 # Datasets
+
+
+def _part_of(run):
+    """The lookup of the run's part parameters that `method_parts` takes: a name or None."""
+    params = run.values("/params")
+    return lambda key: _as_str(params[key]) if key in params else None
 
 
 def _expected_shapes(run):
@@ -163,12 +169,7 @@ def test_conservation(run):
             assert np.isnan(errors[name]), f"{name} = {errors[name]} for a reference solver"
         elif run.status == "ok":
             assert np.isfinite(errors[name]) and errors[name] >= 0, f"{name} = {errors[name]}"
-    params = run.values("/params")
-
-    def part(key):
-        return _as_str(params[key]) if key in params else None
-
-    if run.status == "ok" and conserves(run.attrs["method"], part):
+    if run.status == "ok" and conserves(run.attrs["method"], _part_of(run)):
         dofs = (int(run.attrs["cells"]) + 3) ** int(run.attrs["dim"])
         bound = 4 * np.finfo(float).eps * (len(run.ds("/particles/mass")) + dofs)
         for name in ("max_mass_error", "max_momentum_error"):
@@ -263,10 +264,6 @@ def _axis_coordinates(x, d, per_axis):
     return [x[[i * strides[k] for i in range(per_axis)], k] for k in range(d)]
 
 
-# The root attribute `shape` of the B-spline runs and the degree it names.
-SPLINE_DEGREES = {"quadratic-bspline": 2, "cubic-bspline": 3}
-
-
 def test_grid_dofs_and_weights(run):
     """/grid/x is the lattice of the basis' DOFs (the nodes, or a B-spline's Greville
     abscissae, the means of its interior knots: 0, h/2, 3h/2, ..., L - h/2, L for the quadratic),
@@ -282,7 +279,8 @@ def test_grid_dofs_and_weights(run):
         return
     d, h = int(a["dim"]), float(a["h"])
     # The hat and the bases built on it have a DOF per node, a B-spline of degree p cells + p.
-    degree = SPLINE_DEGREES.get(str(a["shape"]), 1)
+    shape, _ = method_parts(a["method"], _part_of(run))
+    degree = DOF_DEGREES[shape]
     # The grid may reach beyond the body (empty cells for it to move into), so its cells are
     # read from the lattice, not from the `cells` parameter.
     per_axis = int(round(x.shape[0] ** (1.0 / d)))

@@ -177,7 +177,7 @@ pub(super) fn figures(
 /// Shape functions as their line figures order them (LME by gamma, then the other bases);
 /// other runs by their values of the `by` axes.
 fn panel_order(a: &RunSummary, b: &RunSummary, by: &[&str]) -> Ordering {
-    if let (Some(ra), Some(rb)) = (&a.shape_functions, &b.shape_functions) {
+    if let (Some(ra), Some(rb)) = (a.unstepped.shape_functions(), b.unstepped.shape_functions()) {
         return lme_first(ra, rb);
     }
     cmp_params(&by_axes(a, by), &by_axes(b, by))
@@ -194,7 +194,7 @@ fn by_axes(run: &RunSummary, by: &[&str]) -> Params {
 /// The run's values of the `by` axes (a shape function: its basis and gamma), what its layer
 /// notes, and its time when the panels differ in it.
 fn panel_label(run: &RunSummary, by: &[&str], layer: &Layer, with_time: bool) -> String {
-    let axes = match &run.shape_functions {
+    let axes = match run.unstepped.shape_functions() {
         Some(r) => curve_label(r),
         None => label(&by_axes(run, by)),
     };
@@ -215,10 +215,10 @@ fn layer(run: &RunSummary, field: &str) -> Option<Layer> {
     }
     let layer = if let Some(state) = &run.final_state {
         particles(state, field)?
-    } else if let Some(r) = &run.elements {
+    } else if let Some(r) = run.unstepped.elements() {
         elements(r, field)?
     } else {
-        shape_function(run.shape_functions.as_ref()?, field)?
+        shape_function(run.unstepped.shape_functions()?, field)?
     };
     (!layer.cells.is_empty()).then_some(layer)
 }
@@ -236,7 +236,7 @@ fn labels(run: &RunSummary, field: &str) -> Option<Labels> {
             palette: Palette::Viridis,
         });
     }
-    if let Some(r) = &run.elements {
+    if let Some(r) = run.unstepped.elements() {
         let (quantity, what, palette) = match field {
             "reconstructed" => ("u^h", "the element-wise fit of", Palette::Viridis),
             "error" => (
@@ -255,7 +255,7 @@ fn labels(run: &RunSummary, field: &str) -> Option<Labels> {
             palette,
         });
     }
-    run.shape_functions.as_ref()?;
+    run.unstepped.shape_functions()?;
     let (quantity, unit, palette) = match field {
         "value" => ("N_a", "dimensionless", Palette::Viridis),
         "gradient_x" => ("dN_a/dx", "1/h", Palette::BlueWhiteRed),

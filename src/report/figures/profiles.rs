@@ -46,7 +46,7 @@ pub(super) fn reconstructions(runs: &[&RunSummary]) -> Vec<Figure> {
 pub(super) fn element_fits(runs: &[&RunSummary]) -> Vec<Figure> {
     runs.iter()
         .filter_map(|run| {
-            let r = run.elements.as_ref()?;
+            let r = run.unstepped.elements()?;
             let d = r.dim;
             // The height of the samples in 2D; every sample of a 1D run is on the line.
             let level = (d == 2).then(|| r.curve_x.get(1).copied()).flatten();
@@ -164,7 +164,7 @@ where
 {
     runs.iter()
         .filter_map(|run| {
-            let record = run.reconstruction.as_ref()?;
+            let record = run.unstepped.reconstruction()?;
             draw(run, record).into()
         })
         .filter(|figure| {

@@ -23,7 +23,7 @@ pub(super) fn figures(selected: &[&RunSummary], spec: &FigureSpec) -> Vec<Figure
         let mut runs: Vec<(&RunSummary, &ShapeFunctionRecord)> = group
             .runs
             .iter()
-            .filter_map(|run| Some((*run, run.shape_functions.as_ref()?)))
+            .filter_map(|run| Some((*run, run.unstepped.shape_functions()?)))
             .filter(|(_, r)| r.point_count() > 0)
             .collect();
         runs.sort_by(|a, b| lme_first(a.1, b.1));

@@ -10,37 +10,36 @@ use nalgebra::SVector;
 
 use super::base_record;
 use crate::benchmarks::scattered::{ElementProblem, ScatteredData};
-use crate::benchmarks::{self, BenchmarkKind};
+use crate::benchmarks::BenchmarkKind;
+use crate::experiment::ResolvedRun;
 use crate::grid::Grid;
-use crate::output::{ElementRecord, ReconstructionRecord, RunRecord, RunStatus};
+use crate::output::{ElementRecord, ReconstructionRecord, RunRecord, RunStatus, Unstepped};
+use crate::params::Params;
 use crate::reconstruct::{Kernel, Lattice, Recipe, Reconstructor, Solver};
-use crate::reconstruction_methods::{self, Fit, ReconstructionMethod};
+use crate::reconstruction_methods::{Fit, ReconstructionMethod};
 use crate::run_spec::RunSpec;
 
 /// Samples of u on the interval for plots: smooth enough for sin(pi x) at any scale.
 const CURVE_SAMPLES: usize = 401;
 
-/// Runs one configuration, nodal or element-wise by the benchmark's kind.
-pub(super) fn evaluate(spec: &RunSpec) -> RunRecord {
-    let elementwise = benchmarks::CATALOG
-        .find(&spec.benchmark)
-        .is_some_and(|info| info.kind == BenchmarkKind::Elementwise);
-    if elementwise {
-        evaluate_elements(spec)
+/// Runs one configuration of `method`, nodal or element-wise by the benchmark's kind.
+pub(super) fn evaluate(run: &ResolvedRun, method: &'static ReconstructionMethod) -> RunRecord {
+    if run.benchmark.kind == BenchmarkKind::Elementwise {
+        evaluate_elements(run, method)
     } else {
-        evaluate_nodes(spec)
+        evaluate_nodes(run, method)
     }
 }
 
 /// A nodal reconstruction. A run whose method cannot be fitted (a singular MLS moment matrix)
 /// is `failed`, with the evaluation point in `message` and the data still recorded.
-fn evaluate_nodes(spec: &RunSpec) -> RunRecord {
-    let mut record = base_record(spec, String::new());
-    let (data, method, solver) = match prepare(spec) {
+fn evaluate_nodes(run: &ResolvedRun, method: &'static ReconstructionMethod) -> RunRecord {
+    let mut record = base_record(run, String::new());
+    let (data, solver) = match prepare(&run.spec, method) {
         Ok(prepared) => prepared,
         Err(message) => {
             record.message = message;
-            record.reconstruction = Some(ReconstructionRecord {
+            record.unstepped = Unstepped::Reconstruction(ReconstructionRecord {
                 l2: f64::NAN,
                 max: f64::NAN,
                 ..Default::default()
@@ -58,14 +57,14 @@ fn evaluate_nodes(spec: &RunSpec) -> RunRecord {
     out.basis = data
         .basis_centre
         .map(|centre| basis::record(&data, method.degree, grid.h, centre, &out.curve_x));
-    record.reconstruction = Some(out);
+    record.unstepped = Unstepped::Reconstruction(out);
     record
 }
 
 fn prepare(
     spec: &RunSpec,
-) -> Result<(ScatteredData, &'static ReconstructionMethod, Solver), String> {
-    let method = reconstruction_method(spec)?;
+    method: &ReconstructionMethod,
+) -> Result<(ScatteredData, Solver), String> {
     let Fit::Local(solver) = method.fit else {
         return Err(format!(
             "'{}' fits element by element; a nodal benchmark needs a local method",
@@ -74,53 +73,23 @@ fn prepare(
     };
     let data =
         ScatteredData::from_params(&spec.benchmark, &spec.params).map_err(|e| e.to_string())?;
-    Ok((data, method, solver))
-}
-
-fn reconstruction_method(spec: &RunSpec) -> Result<&'static ReconstructionMethod, String> {
-    reconstruction_methods::METHODS
-        .find(&spec.method)
-        .ok_or_else(|| {
-            format!(
-                "unknown reconstruction method '{}'; valid: {}",
-                spec.method,
-                reconstruction_methods::METHODS.names().join(", ")
-            )
-        })
+    Ok((data, solver))
 }
 
 /// An element-wise reconstruction: every element fitted on its own, errors at Gauss points.
 /// A run that cannot start is `failed` with the reason in `message`.
-fn evaluate_elements(spec: &RunSpec) -> RunRecord {
-    let mut record = base_record(spec, String::new());
-    let fitted = reconstruction_method(spec).and_then(|method| {
-        let Fit::Taylor(conservation) = method.fit else {
-            return Err(format!(
-                "'{}' is a local fit; the element-wise benchmark needs a tls method",
-                method.name
-            ));
-        };
-        let problem = ElementProblem::from_params(&spec.params).map_err(|e| e.to_string())?;
-        let degree = method.degree.value();
-        Ok(match problem {
-            ElementProblem::Line(data) => {
-                (data.h(), elements::reconstruct(&data, degree, conservation))
-            }
-            ElementProblem::Surface(data) => {
-                (data.h(), elements::reconstruct(&data, degree, conservation))
-            }
-        })
-    });
-    match fitted {
+fn evaluate_elements(run: &ResolvedRun, method: &ReconstructionMethod) -> RunRecord {
+    let mut record = base_record(run, String::new());
+    match fit_elements(&run.spec.params, method) {
         Ok((h, out)) => {
             record.status = RunStatus::Ok;
             record.dim = out.dim;
             record.h = h;
-            record.elements = Some(out);
+            record.unstepped = Unstepped::Elements(out);
         }
         Err(message) => {
             record.message = message;
-            record.elements = Some(ElementRecord {
+            record.unstepped = Unstepped::Elements(ElementRecord {
                 rms: f64::NAN,
                 integral: f64::NAN,
                 exact_integral: f64::NAN,
@@ -130,6 +99,29 @@ fn evaluate_elements(spec: &RunSpec) -> RunRecord {
         }
     }
     record
+}
+
+/// Every element's fit of the data `params` describe by `method`, with the element size.
+fn fit_elements(
+    params: &Params,
+    method: &ReconstructionMethod,
+) -> Result<(f64, ElementRecord), String> {
+    let Fit::Taylor(conservation) = method.fit else {
+        return Err(format!(
+            "'{}' is a local fit; the element-wise benchmark needs a tls method",
+            method.name
+        ));
+    };
+    let problem = ElementProblem::from_params(params).map_err(|e| e.to_string())?;
+    let degree = method.degree.value();
+    Ok(match problem {
+        ElementProblem::Line(data) => {
+            (data.h(), elements::reconstruct(&data, degree, conservation))
+        }
+        ElementProblem::Surface(data) => {
+            (data.h(), elements::reconstruct(&data, degree, conservation))
+        }
+    })
 }
 
 /// The record before the fit: the method, the data and the exact values; the fit's outputs
