@@ -458,7 +458,7 @@ fn param_json(p: &benchmarks::ParamSpec) -> Value {
         benchmarks::ParamDefault::Required => Value::Null,
         benchmarks::ParamDefault::Int(i) => json!(i),
         benchmarks::ParamDefault::Float(x) => json!(x),
-        benchmarks::ParamDefault::Text(s) => json!(s),
+        benchmarks::ParamDefault::Text(s) | benchmarks::ParamDefault::Implicit(s) => json!(s),
     };
     json!({
         "key": p.key,
@@ -641,7 +641,9 @@ fn print_param(p: &benchmarks::ParamSpec) {
         benchmarks::ParamDefault::Required => "required".to_string(),
         benchmarks::ParamDefault::Int(i) => format!("default {i}"),
         benchmarks::ParamDefault::Float(x) => format!("default {x:?}"),
-        benchmarks::ParamDefault::Text(s) => format!("default {s}"),
+        benchmarks::ParamDefault::Text(s) | benchmarks::ParamDefault::Implicit(s) => {
+            format!("default {s}")
+        }
     };
     let choices = match p.kind {
         benchmarks::ParamKind::Choice(names) => format!(" (one of: {})", names.join(", ")),

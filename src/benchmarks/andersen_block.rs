@@ -14,17 +14,13 @@ use std::f64::consts::PI;
 use nalgebra::{SMatrix, SVector, Vector2};
 
 use super::limits::{check_lattice, courant_time_step};
-use super::{boxed, BenchmarkKind, Build};
+use super::{boxed, placement, BenchmarkKind, Build, PLACEMENTS, PLACEMENT_KEY};
 use super::{courant_number, ParamError, Params, Probe, ProbeQuantity, Problem, TimeStep};
 use super::{BenchmarkInfo, ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec};
 use crate::grid::Domain;
 use crate::material::{LinearElasticRate, Material};
-use crate::params::{get_f64, get_str, get_usize};
+use crate::params::{get_f64, get_usize};
 use crate::particles::Placement;
-
-/// Values of `placement`: the Gauss points of each cell (the paper's choice for the hat and
-/// LME), or the sub-cell centres (its choice for uGIMP, whose domains must not overlap).
-pub const PLACEMENTS: &[&str] = &["gauss", "centres"];
 
 const PARAMS: &[ParamSpec] = &[
     ParamSpec {
@@ -56,8 +52,9 @@ const PARAMS: &[ParamSpec] = &[
         doc: "material points per cell and axis",
     },
     ParamSpec {
-        key: "placement",
+        key: PLACEMENT_KEY,
         kind: ParamKind::Choice(PLACEMENTS),
+        // The paper's choice for the hat and LME; uGIMP's domains need the centres.
         default: ParamDefault::Text("gauss"),
         unit: "1",
         doc: "gauss: the Gauss points of each cell; centres: the sub-cell centres \
@@ -155,10 +152,7 @@ pub struct AndersenBlock {
 impl AndersenBlock {
     fn new(params: &Params) -> Result<Self, ParamError> {
         let TimeStep { dt, steps } = time_step(params)?;
-        let placement = match get_str(params, "placement")? {
-            "centres" => Placement::SubCellCentres,
-            _ => Placement::Gauss,
-        };
+        let placement = placement(params, Placement::Gauss)?;
         Ok(AndersenBlock {
             height: get_f64(params, "H")?,
             cells: get_usize(params, "cells")?,

@@ -115,7 +115,7 @@ fn culprit(params: &Params, specs: &[ParamSpec], powers: &[(&'static str, f64)])
             .and_then(|s| match s.default {
                 ParamDefault::Int(i) => Some(i as f64),
                 ParamDefault::Float(x) => Some(x),
-                ParamDefault::Required | ParamDefault::Text(_) => None,
+                ParamDefault::Required | ParamDefault::Text(_) | ParamDefault::Implicit(_) => None,
             });
         match (params.get(key).and_then(ParamValue::as_f64), default) {
             (Some(value), Some(default)) => (value / default).powf(power),

@@ -7,10 +7,11 @@ use std::f64::consts::PI;
 
 use super::limits::{check_lattice, courant_time_step};
 use super::sine_mms::{SineMms, SineMmsSpec, SineWave, CELLS, PPC, RHO0};
-use super::{boxed, BenchmarkKind, Build};
+use super::{boxed, placement, BenchmarkKind, Build, PLACEMENTS, PLACEMENT_KEY};
 use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{lame_from_young, NeoHookean};
 use crate::params::{get_f64, get_usize};
+use crate::particles::Placement;
 
 const PARAMS: &[ParamSpec] = &[
     ParamSpec {
@@ -57,6 +58,15 @@ const PARAMS: &[ParamSpec] = &[
         doc: "largest accepted Courant number dt c_p / h; raise it only to study instability",
     },
     PPC,
+    ParamSpec {
+        key: PLACEMENT_KEY,
+        kind: ParamKind::Choice(PLACEMENTS),
+        default: ParamDefault::Implicit("centres"),
+        unit: "1",
+        doc: "where the ppc^D points of a cell sit: centres, the sub-cell centres (Gong's \
+              choice); gauss, the Gauss points, whose rule is exact for polynomials of \
+              degree 2 ppc - 1 on the cell",
+    },
     CELLS,
 ];
 
@@ -179,6 +189,7 @@ pub fn gong_mms<const D: usize>(params: &Params) -> Result<SineMms<D>, ParamErro
         material: NeoHookean { lambda, mu },
         cells,
         ppc: get_usize(params, "ppc")?,
+        placement: placement(params, Placement::SubCellCentres)?,
         step: time_step(params)?,
     }))
 }
@@ -244,5 +255,36 @@ mod tests {
             e.message.contains("> 1.5") && e.message.contains("Use cfl <= 1.2928"),
             "{e}"
         );
+    }
+
+    /// `placement` is left out of a run's parameters unless the run sets it, so adding it kept
+    /// every run's id; unset it seeds the sub-cell centres, `gauss` the 2-point Gauss points.
+    #[test]
+    fn placement_is_implicit_and_seeds_the_centres_or_the_gauss_points() {
+        assert!(!crate::benchmarks::default_params(PARAMS).contains_key(PLACEMENT_KEY));
+        let seeded = |params: &Params| -> Vec<f64> {
+            let m = gong_mms::<1>(params).unwrap();
+            let grid = crate::grid::Grid::new(&m.domain());
+            m.seed_particles(&grid).x0.iter().map(|x| x[0]).collect()
+        };
+        let mut params = thesis_params(1e-4, 4, 2);
+        let h = 0.25;
+        let offset = 0.5 / 3f64.sqrt();
+        for (placement, inner) in [(None, 0.25), (Some("gauss"), 0.5 - offset)] {
+            if let Some(name) = placement {
+                params.insert(PLACEMENT_KEY.into(), ParamValue::Str(name.into()));
+            }
+            let x = seeded(&params);
+            assert_eq!(x.len(), 8);
+            for (c, pair) in x.chunks(2).enumerate() {
+                let expected = [(c as f64 + inner) * h, (c as f64 + 1.0 - inner) * h];
+                for (got, want) in pair.iter().zip(expected) {
+                    assert!(
+                        (got - want).abs() < 1e-15,
+                        "{placement:?}: {got} against {want}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -10,6 +10,7 @@ use super::{boxed, BenchmarkKind, Build};
 use super::{BenchmarkInfo, ParamDefault, ParamError, ParamKind, ParamSpec, Params, TimeStep};
 use crate::material::{young_from_lame, NeoHookean};
 use crate::params::{get_f64, get_usize};
+use crate::particles::Placement;
 
 const PARAMS: &[ParamSpec] = &[
     ParamSpec {
@@ -138,6 +139,7 @@ pub fn tran_mms(params: &Params) -> Result<SineMms<1>, ParamError> {
         material,
         cells: get_usize(params, "cells")?,
         ppc: get_usize(params, "ppc")?,
+        placement: Placement::SubCellCentres,
         step: time_step(params)?,
     }))
 }

@@ -18,7 +18,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::catalog::{Catalog, Named};
 use crate::grid::{Domain, Grid};
 use crate::material::Material;
-use crate::params::{ParamError, ParamValue, Params};
+use crate::params::{get_str, ParamError, ParamValue, Params};
 use crate::particles::{Body, Particles, Placement};
 
 pub use limits::{TimeStep, LIMIT_PARAMS, MAX_POINTS, MAX_STEPS, MAX_STEPS_KEY};
@@ -47,6 +47,10 @@ pub enum ParamDefault {
     Int(i64),
     Float(f64),
     Text(&'static str),
+    /// The choice a run takes when its file does not set the parameter, left out of the
+    /// run's parameters (and so of its id and configuration) unless set: a parameter added to
+    /// a benchmark this way keeps every existing run's id.
+    Implicit(&'static str),
 }
 
 pub struct ParamSpec {
@@ -63,7 +67,7 @@ pub fn default_params(specs: &[ParamSpec]) -> Params {
         .iter()
         .filter_map(|spec| {
             let value = match spec.default {
-                ParamDefault::Required => return None,
+                ParamDefault::Required | ParamDefault::Implicit(_) => return None,
                 ParamDefault::Int(i) => ParamValue::Int(i),
                 ParamDefault::Float(x) => ParamValue::Float(x),
                 ParamDefault::Text(s) => ParamValue::Str(s.to_string()),
@@ -71,6 +75,22 @@ pub fn default_params(specs: &[ParamSpec]) -> Params {
             Some((spec.key.to_string(), value))
         })
         .collect()
+}
+
+/// The seeding parameter of the benchmarks that offer a choice of particle placement, and its
+/// values: the Gauss points of each cell, or the sub-cell centres.
+pub const PLACEMENT_KEY: &str = "placement";
+pub const PLACEMENTS: &[&str] = &["gauss", "centres"];
+
+/// The placement a run's `placement` names; `absent` where it names none.
+fn placement(params: &Params, absent: Placement) -> Result<Placement, ParamError> {
+    if !params.contains_key(PLACEMENT_KEY) {
+        return Ok(absent);
+    }
+    Ok(match get_str(params, PLACEMENT_KEY)? {
+        "gauss" => Placement::Gauss,
+        _ => Placement::SubCellCentres,
+    })
 }
 
 /// Catalogue entry of a benchmark: what `list-benchmarks` prints and what validation uses.

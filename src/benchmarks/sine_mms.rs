@@ -9,6 +9,7 @@ use super::TimeStep;
 use super::{ExactState, FixedFaces, ParamDefault, ParamKind, ParamSpec, Problem};
 use crate::grid::Domain;
 use crate::material::{Material, NeoHookean};
+use crate::particles::Placement;
 
 /// Parameters every manufactured benchmark of this family takes with the same meaning.
 pub const RHO0: ParamSpec = ParamSpec {
@@ -53,6 +54,7 @@ pub struct SineMmsSpec {
     pub material: NeoHookean,
     pub cells: usize,
     pub ppc: usize,
+    pub placement: Placement,
     /// The benchmark's time step, the one its check approved.
     pub step: TimeStep,
 }
@@ -69,6 +71,7 @@ pub struct SineMms<const D: usize> {
     material: NeoHookean,
     cells: usize,
     ppc: usize,
+    placement: Placement,
     dt: f64,
     steps: usize,
     /// The body force of particle p depends on each X_k separately, and particles seeded on
@@ -102,6 +105,7 @@ impl<const D: usize> SineMms<D> {
             material: spec.material,
             cells: spec.cells,
             ppc: spec.ppc,
+            placement: spec.placement,
             dt: spec.step.dt,
             steps: spec.step.steps,
             axes: std::array::from_fn(|_| AxisTable::default()),
@@ -120,6 +124,9 @@ impl<const D: usize> SineMms<D> {
 }
 
 impl<const D: usize> Problem<D> for SineMms<D> {
+    fn placement(&self) -> Placement {
+        self.placement
+    }
     fn domain(&self) -> Domain<D> {
         Domain {
             lower: SVector::zeros(),
@@ -337,6 +344,7 @@ pub(super) mod tests {
             material: NeoHookean { lambda, mu },
             cells: 8,
             ppc: 2,
+            placement: Placement::SubCellCentres,
             step: TimeStep {
                 dt: 1e-3,
                 steps: 20,

@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use crate::benchmarks;
+use crate::benchmarks::{self, PLACEMENT_KEY};
 use crate::methods;
 use crate::params::{ParamError, ParamValue, Params};
 use crate::reference;
@@ -18,8 +18,7 @@ use super::values::{method_names, METHOD_KEY};
 use super::yaml::child_field;
 use crate::run_spec::RunSpec;
 
-/// The seeding parameter of benchmarks that offer a choice of particle placement.
-const PLACEMENT_KEY: &str = "placement";
+/// The placement at the Gauss points, which the particle-domain methods cannot take.
 const GAUSS_PLACEMENT: &str = "gauss";
 
 /// More runs than this is taken to be a mistake in the matrix, not a plan.
