@@ -39,10 +39,26 @@ pub(super) fn mark_coincident(figure: &mut Figure) {
         let Some(i) = (0..j).find(|&i| close(&figure.series[i], &figure.series[j])) else {
             continue;
         };
-        let under = short(&figure.series[i].label).to_string();
+        let under = distinct(&figure.series[i].label, &figure.series[j].label);
         figure.series[j]
             .label
             .push_str(&format!(" (on top of {under})"));
+    }
+}
+
+/// The series `under` named by the comma-separated parts of its name that `own`'s name lacks
+/// ("ppc=2" for "velocity, transfer=shepard, ppc=2" under "velocity, transfer=shepard, ppc=4"),
+/// so that the note stays short; its whole name when every part is shared.
+fn distinct(under: &str, own: &str) -> String {
+    let own: Vec<&str> = short(own).split(", ").collect();
+    let parts: Vec<&str> = short(under)
+        .split(", ")
+        .filter(|part| !own.contains(part))
+        .collect();
+    if parts.is_empty() {
+        short(under).to_string()
+    } else {
+        parts.join(", ")
     }
 }
 
@@ -82,5 +98,28 @@ mod tests {
         assert_eq!(f.series[0].label, "mpm (rate 2.00)");
         assert_eq!(f.series[1].label, "mpm_tls (rate 2.00) (on top of mpm)");
         assert_eq!(f.series[2].label, "ddmpm (rate 2.00)");
+    }
+
+    /// Names that share parts are told apart by the parts that differ.
+    #[test]
+    fn the_note_names_the_parts_that_differ() {
+        let points = vec![(0.1, 1.0), (0.05, 0.25)];
+        let mut f = figure(vec![
+            Series::markers(
+                "v, transfer=tls, ppc=2 (rate 2.00)".into(),
+                Marker::Circle,
+                points.clone(),
+            ),
+            Series::markers(
+                "v, transfer=tls, ppc=4 (rate 2.00)".into(),
+                Marker::Square,
+                points,
+            ),
+        ]);
+        mark_coincident(&mut f);
+        assert_eq!(
+            f.series[1].label,
+            "v, transfer=tls, ppc=4 (rate 2.00) (on top of ppc=2)"
+        );
     }
 }
