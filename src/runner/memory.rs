@@ -1,5 +1,5 @@
 //! The memory the runs of a matrix may use together: the machine's available memory when the
-//! matrix starts, or what `--memory` says. A run whose estimate (`solver::estimated_bytes`)
+//! matrix starts, or what `--memory` says. A run whose estimate (`solver::Job::estimated_bytes`)
 //! exceeds it is refused and recorded as failed; the others start only while the estimates of
 //! the runs in progress leave room for theirs, so which runs are refused and which numbers
 //! they give do not depend on `--jobs`.
