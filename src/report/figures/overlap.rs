@@ -48,23 +48,33 @@ pub(super) fn mark_coincident(figure: &mut Figure) {
 
 /// The series `under` named by the comma-separated parts of its name that `own`'s name lacks
 /// ("ppc=2" for "velocity, transfer=shepard, ppc=2" under "velocity, transfer=shepard, ppc=4"),
-/// so that the note stays short; its whole name when every part is shared.
+/// so that the note stays short; its whole name when every part is shared. A field's unit is
+/// left out of the note, which holds no parentheses.
 fn distinct(under: &str, own: &str) -> String {
-    let own: Vec<&str> = short(own).split(", ").collect();
-    let parts: Vec<&str> = short(under)
+    let own: Vec<&str> = name(own).split(", ").collect();
+    let mut parts: Vec<&str> = name(under)
         .split(", ")
         .filter(|part| !own.contains(part))
         .collect();
     if parts.is_empty() {
-        short(under).to_string()
-    } else {
-        parts.join(", ")
+        parts = name(under).split(", ").collect();
     }
+    parts
+        .iter()
+        .map(|part| part.split(" (").next().unwrap_or(part))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
-/// A label without its own `(...)` remarks: the series' name.
-fn short(label: &str) -> &str {
-    label.split(" (").next().unwrap_or(label)
+/// A series' name: its label without the remarks that follow it, `(rate ...)` and
+/// `(on top of ...)`; a field's unit, which follows the field in parentheses, stays.
+fn name(label: &str) -> &str {
+    let end = [" (rate ", " (on top of "]
+        .iter()
+        .filter_map(|remark| label.find(remark))
+        .min()
+        .unwrap_or(label.len());
+    &label[..end]
 }
 
 #[cfg(test)]
@@ -120,6 +130,28 @@ mod tests {
         assert_eq!(
             f.series[1].label,
             "v, transfer=tls, ppc=4 (rate 2.00) (on top of ppc=2)"
+        );
+    }
+
+    /// A field's unit in parentheses is part of the name, not a remark, and stays out of the
+    /// note.
+    #[test]
+    fn units_are_kept_apart_from_the_remarks() {
+        let points = vec![(0.1, 1.0), (0.05, 0.25)];
+        let series = |label: &str| Series::markers(label.into(), Marker::Square, points.clone());
+        let mut f = figure(vec![
+            series("v (m/s), method=a (rate 2.00)"),
+            series("v (m/s), method=b (rate 2.00)"),
+            series("u (m), method=a (rate 2.00)"),
+        ]);
+        mark_coincident(&mut f);
+        assert_eq!(
+            f.series[1].label,
+            "v (m/s), method=b (rate 2.00) (on top of method=a)"
+        );
+        assert_eq!(
+            f.series[2].label,
+            "u (m), method=a (rate 2.00) (on top of v)"
         );
     }
 }
