@@ -17,7 +17,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
 use plotters_backend::{BackendCoord, DrawingErrorKind};
 
-use super::figures::{Figure, Marker, Scale};
+use super::figures::{Figure, Marker, Scale, Series};
 use super::fit::min_max;
 use super::format::general;
 use super::style::{self, Pattern, Style};
@@ -31,6 +31,8 @@ const Y_LABEL_AREA: u32 = 80;
 const LEGEND_ROW: u32 = 24;
 /// Labels longer than this (about 300 px at 16 px) would run into the next column.
 const LEGEND_COLUMN_CHARS: usize = 34;
+/// Longest line of a legend entry in one column: what fits beside the glyph at its font.
+const LEGEND_LINE_CHARS: usize = 78;
 /// The legend's sample of a series, and where its label starts.
 const GLYPH_WIDTH: i32 = 30;
 const LABEL_OFFSET: i32 = 38;
@@ -92,7 +94,11 @@ pub(super) fn png(
 
 fn draw(figure: &Figure) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     let columns = legend_columns(figure);
-    let rows = figure.series.len().div_ceil(columns) as u32;
+    let labels = legend_labels(&figure.series, columns);
+    let rows = match columns {
+        1 => labels.iter().map(Vec::len).sum::<usize>() as u32,
+        _ => figure.series.len().div_ceil(columns) as u32,
+    };
     let notes: Vec<String> = figure
         .notes
         .iter()
@@ -106,7 +112,7 @@ fn draw(figure: &Figure) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
         let (legend, note_area) = below.split_vertically(legend_height);
         let styles = style::assign(&figure.series);
         draw_axes(&axes, figure, &styles)?;
-        draw_legend(&legend, figure, &styles, columns)?;
+        draw_legend(&legend, &labels, &styles, columns)?;
         draw_notes(&note_area, &notes)?;
         root.present()?;
         Ok(())
@@ -349,17 +355,45 @@ fn legend_columns(figure: &Figure) -> usize {
     }
 }
 
-/// Legend entries in columns aligned with the plot's left edge, filled row by row.
-fn draw_legend(area: &Area, figure: &Figure, styles: &[Style], columns: usize) -> DrawResult {
+/// Each series' legend entry in lines: one in two columns, whose labels are short; in one
+/// column broken at spaces where it is longer than the legend is wide.
+fn legend_labels(series: &[Series], columns: usize) -> Vec<Vec<String>> {
+    series
+        .iter()
+        .map(|s| match columns {
+            1 => wrap(&s.label, LEGEND_LINE_CHARS),
+            _ => vec![s.label.clone()],
+        })
+        .collect()
+}
+
+/// Legend entries in columns aligned with the plot's left edge, filled row by row; in one
+/// column an entry's further lines follow it.
+fn draw_legend(
+    area: &Area,
+    labels: &[Vec<String>],
+    styles: &[Style],
+    columns: usize,
+) -> DrawResult {
     let left = (MARGIN + Y_LABEL_AREA) as i32;
     let column_width = (WIDTH - MARGIN - Y_LABEL_AREA - MARGIN) as i32 / columns as i32;
     let font = TextStyle::from((FONT, 16).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
-    for (i, (series, style)) in figure.series.iter().zip(styles).enumerate() {
+    let mut row = 0;
+    for (i, (lines, style)) in labels.iter().zip(styles).enumerate() {
         let x = left + (i % columns) as i32 * column_width;
-        let y = ((i / columns) as u32 * LEGEND_ROW + LEGEND_ROW / 2) as i32;
-        draw_glyph(area, style, (x, y))?;
-        let at = (x + LABEL_OFFSET, y);
-        area.draw(&Text::new(series.label.clone(), at, font.clone()))?;
+        if columns > 1 {
+            row = (i / columns) as u32;
+        }
+        let y = |row: u32| (row * LEGEND_ROW + LEGEND_ROW / 2) as i32;
+        draw_glyph(area, style, (x, y(row)))?;
+        for line in lines {
+            area.draw(&Text::new(
+                line.clone(),
+                (x + LABEL_OFFSET, y(row)),
+                font.clone(),
+            ))?;
+            row += 1;
+        }
     }
     Ok(())
 }
@@ -528,6 +562,28 @@ mod tests {
         assert_eq!(padded_linear_range([0.0, 0.0].into_iter()), (-0.1, 0.1));
         let (lo, hi) = padded_linear_range([-1.0, f64::NAN, 1.0].into_iter());
         assert!((lo + 1.1).abs() < 1e-12 && (hi - 1.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn long_legend_entries_wrap_in_one_column() {
+        let long =
+            "v, method=a, sampled_velocity=centred, dt=1e-7 (rate 1.99) (on top of method=b)";
+        let series = |label: &str| Series::markers(label.into(), Marker::Circle, vec![(1.0, 1.0)]);
+        let labels = legend_labels(&[series("short"), series(long)], 1);
+        assert_eq!(labels[0], ["short"]);
+        assert_eq!(labels[1].len(), 2);
+        assert!(labels[1]
+            .iter()
+            .all(|line| line.chars().count() <= LEGEND_LINE_CHARS));
+        assert_eq!(
+            labels[1]
+                .join(" ")
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" "),
+            long
+        );
+        assert_eq!(legend_labels(&[series(long)], 2), [[long]]);
     }
 
     #[test]
