@@ -86,7 +86,8 @@ impl ResolvedRun {
 
 impl RunMethod {
     /// The method `name` of a run of `benchmark` with `params`, looked up in the catalogue of
-    /// the benchmark's kind; an MPM preset resolved with the run's method parameters.
+    /// the benchmark's kind: a reference solver only for a benchmark it solves, an MPM preset
+    /// resolved with the run's method parameters.
     pub(super) fn resolve(
         name: &str,
         benchmark: &BenchmarkInfo,
@@ -95,7 +96,10 @@ impl RunMethod {
         let unknown = |e: String| ParamError::new(METHOD_KEY, e);
         Ok(match benchmark.kind {
             BenchmarkKind::Simulation => match reference::METHODS.find(name) {
-                Some(solver) => RunMethod::Reference(solver),
+                Some(solver) => match reference::unsupported(name, benchmark.name) {
+                    Some(reason) => return Err(ParamError::new(METHOD_KEY, reason)),
+                    None => RunMethod::Reference(solver),
+                },
                 None => {
                     let preset = methods::PRESETS.get(name).map_err(unknown)?;
                     RunMethod::Mpm(methods::resolve(preset, params, benchmark.dim())?)
@@ -131,5 +135,43 @@ impl fmt::Debug for RunMethod {
             RunMethod::Reconstruction(m) => f.debug_tuple("Reconstruction").field(&m.name).finish(),
             RunMethod::Basis(m) => f.debug_tuple("Basis").field(&m.name).finish(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::benchmarks::thesis_params;
+    use crate::params::Params;
+
+    fn spec(benchmark: &str, method: &str) -> RunSpec {
+        RunSpec {
+            experiment: "t".into(),
+            run_id: "t".into(),
+            benchmark: benchmark.into(),
+            method: method.into(),
+            params: thesis_params(1e-4, 8, 2),
+            axes: Params::new(),
+            output_every: 0,
+            config_yaml: String::new(),
+        }
+    }
+
+    /// A hand-built spec gets its method, sizes and step count, or an error that names the
+    /// parameter: an unknown benchmark, or a reference solver on a benchmark it does not solve.
+    #[test]
+    fn a_hand_built_spec_is_resolved_or_refused_by_name() {
+        let run = ResolvedRun::resolve(spec("mms1d_gong", "mpm")).unwrap();
+        assert!(matches!(run.method, RunMethod::Mpm(_)));
+        assert_eq!(
+            (run.cells, run.ppc, run.steps, run.dim()),
+            (8, 2, Some(40), 1)
+        );
+        assert_eq!(run.t_end, 0.02);
+        let refused =
+            |benchmark, method| ResolvedRun::resolve(spec(benchmark, method)).unwrap_err();
+        assert_eq!(refused("mms1d_gong", "ulfem").key, "method");
+        assert_eq!(refused("no_such_benchmark", "mpm").key, "benchmark");
+        assert_eq!(refused("mms1d_gong", "no_such_method").key, "method");
     }
 }

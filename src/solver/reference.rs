@@ -10,7 +10,7 @@ use crate::experiment::ResolvedRun;
 use crate::output::{MethodParts, RunRecord};
 use crate::reference::UlFem;
 
-/// Runs `run`, whose method is a reference solver (expansion has checked that it solves the
+/// Runs `run`, whose method is a reference solver (its resolution has checked that it solves the
 /// run's benchmark), on its `problem`.
 pub(super) fn solve(
     run: &ResolvedRun,
