@@ -1,10 +1,11 @@
 //! Probe histories (Molinos Figs 5-13): a probe's value against time, one line per run, with
-//! the benchmark's reference drawn once in grey. A diverged run's line stops where it did,
+//! the benchmark's reference in grey, once per problem. A diverged run's line stops where it did,
 //! marked with a cross.
 
 use super::{default_stem, Figure, Marker, Scale, Series};
 use crate::experiment::{Experiment, FigureSpec};
 use crate::output::{ProbeRecord, RunStatus, RunSummary};
+use crate::params::Params;
 use crate::report::format::general;
 use crate::report::group::{
     group_runs, label, label_or_all, recorded_probes, scoped_pairs, title_suffix,
@@ -47,9 +48,11 @@ pub(super) fn figures(
             continue;
         };
         let mut series: Vec<Series> = probes.iter().map(|(run, p)| line(run, p, &drop)).collect();
-        if let Some(reference) = reference(&probes) {
-            series.push(reference);
-        }
+        let axes_and_probes: Vec<(&Params, &ProbeRecord)> = probes
+            .iter()
+            .map(|(run, probe)| (&run.axes, *probe))
+            .collect();
+        series.extend(references(&axes_and_probes, &drop));
         let variant = scoped_pairs(&group.axes, &spec.select);
         let scope = label(variant.iter().map(|(k, v)| (k, v)));
         let which = format!("{name}_{}", label_or_all(&scope));
@@ -98,22 +101,54 @@ fn line(run: &RunSummary, probe: &ProbeRecord, by: &[&str]) -> Series {
     series
 }
 
-/// The reference of the first run that has one, in grey, labelled by its kind.
-fn reference(probes: &[(&RunSummary, &ProbeRecord)]) -> Option<Series> {
-    let (_, probe) = probes
-        .iter()
-        .find(|(_, p)| p.reference.iter().any(|r| r.is_finite()))?;
-    let points = probe
-        .time
-        .iter()
-        .copied()
-        .zip(probe.reference.iter().copied());
-    let mut series = Series::line(
-        probe.reference_kind.clone(),
-        envelope(points.filter(|(_, r)| r.is_finite()).collect(), BUCKETS),
-    );
-    series.neutral = true;
-    Some(series)
+/// Two runs' references are drawn as one when their final values agree to this fraction of
+/// the larger: the same reference seen from particles a little apart, not another problem.
+const SAME_REFERENCE: f64 = 0.01;
+
+/// The runs' references in grey, labelled by their kind: once for runs whose references agree
+/// (`SAME_REFERENCE`), and where a `by` axis changes the problem (the load, say) once per
+/// reference, each labelled with the values of the `by` axes of the first run that has it.
+fn references(probes: &[(&Params, &ProbeRecord)], by: &[&str]) -> Vec<Series> {
+    let last = |p: &ProbeRecord| p.reference.iter().rev().copied().find(|r| r.is_finite());
+    let mut distinct: Vec<(&Params, &ProbeRecord)> = Vec::new();
+    for &(axes, probe) in probes {
+        let Some(value) = last(probe) else {
+            continue;
+        };
+        let same = |other: &ProbeRecord| {
+            last(other)
+                .is_some_and(|o| (o - value).abs() <= SAME_REFERENCE * o.abs().max(value.abs()))
+        };
+        if !distinct.iter().any(|(_, other)| same(other)) {
+            distinct.push((axes, probe));
+        }
+    }
+    let several = distinct.len() > 1;
+    distinct
+        .into_iter()
+        .map(|(axes, probe)| {
+            let points = probe
+                .time
+                .iter()
+                .copied()
+                .zip(probe.reference.iter().copied());
+            let name = if several {
+                let axes: Vec<(&String, &_)> = axes
+                    .iter()
+                    .filter(|(k, _)| by.contains(&k.as_str()))
+                    .collect();
+                format!("{}, {}", probe.reference_kind, label(axes))
+            } else {
+                probe.reference_kind.clone()
+            };
+            let mut series = Series::line(
+                name,
+                envelope(points.filter(|(_, r)| r.is_finite()).collect(), BUCKETS),
+            );
+            series.neutral = true;
+            series
+        })
+        .collect()
 }
 
 /// A line of many points as the axes can show it: split into `buckets` runs of consecutive
@@ -155,7 +190,35 @@ fn quantity_label(probe: &ProbeRecord) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::envelope;
+    use super::{envelope, references};
+    use crate::output::ProbeRecord;
+    use crate::params::{ParamValue, Params};
+
+    /// References that agree to 1 % are drawn once, unlabelled; others once each, labelled with
+    /// the `by` axes of the first run that has it.
+    #[test]
+    fn each_reference_is_drawn_once_and_named_when_there_are_several() {
+        let probe = |last: f64| ProbeRecord {
+            reference_kind: "static".into(),
+            time: vec![0.0, 1.0],
+            reference: vec![0.0, last],
+            ..Default::default()
+        };
+        let axes = |g: f64| Params::from([("g".to_string(), ParamValue::Float(g))]);
+        let (a, b, c) = (axes(9.81), axes(9.81), axes(4.0));
+        let (pa, pb, pc) = (probe(-0.59), probe(-0.5905), probe(-0.24));
+        let names = |pairs: &[(&Params, &ProbeRecord)]| -> Vec<String> {
+            references(pairs, &["g"])
+                .into_iter()
+                .map(|s| s.label)
+                .collect()
+        };
+        assert_eq!(names(&[(&a, &pa), (&b, &pb)]), ["static"]);
+        assert_eq!(
+            names(&[(&a, &pa), (&b, &pb), (&c, &pc)]),
+            ["static, g=9.81", "static, g=4.0"]
+        );
+    }
 
     /// A short line is kept whole; a long one keeps each bucket's extremes and both ends.
     #[test]
