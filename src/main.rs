@@ -8,7 +8,6 @@ use serde_json::{json, Value};
 use mpmlab::catalog::Parts;
 use mpmlab::collect::{collect, Collected};
 use mpmlab::experiment::Experiment;
-use mpmlab::grid::Dofs;
 use mpmlab::output::{remove_dead_temps, write_atomically};
 use mpmlab::runner::{
     check_copy, check_distinct_names, parse_size, results_dir, run_experiment, RunOptions,
@@ -489,10 +488,7 @@ fn shapes_json() -> Value {
         .flatten()
         .zip(shape::SHAPES.entries)
     {
-        json["dof_degree"] = json!(match entry.value.dofs() {
-            Dofs::Nodes => 1,
-            Dofs::BSpline { degree } => degree,
-        });
+        json["dof_degree"] = json!(entry.value.dofs().degree());
     }
     shapes
 }

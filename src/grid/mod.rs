@@ -21,6 +21,17 @@ pub enum Dofs {
     BSpline { degree: usize },
 }
 
+impl Dofs {
+    /// The degree of the DOF lattice: cells + degree DOFs per axis (1 for the nodes, which
+    /// are the Greville abscissae of the hat).
+    pub fn degree(self) -> usize {
+        match self {
+            Dofs::Nodes => 1,
+            Dofs::BSpline { degree } => degree,
+        }
+    }
+}
+
 /// A uniform background grid: `cells` cells of size `h` per direction, and the DOFs of its
 /// basis ("nodes") numbered with the first axis fastest.
 #[derive(Clone, Debug)]
@@ -45,10 +56,7 @@ impl<const D: usize> Grid<D> {
     /// A grid over `domain` whose basis has the DOFs `dofs`.
     pub fn with_dofs(domain: &Domain<D>, dofs: Dofs) -> Self {
         let h = (domain.upper[0] - domain.lower[0]) / domain.cells as f64;
-        let n = match dofs {
-            Dofs::Nodes => domain.cells + 1,
-            Dofs::BSpline { degree } => domain.cells + degree,
-        };
+        let n = domain.cells + dofs.degree();
         let strides = lattice_strides(&[n; D]);
         Grid {
             lower: domain.lower,

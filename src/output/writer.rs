@@ -26,16 +26,22 @@ pub fn write_record(
     stream: Option<HistoryStream>,
 ) -> hdf5::Result<()> {
     write_identity(file, r)?;
-    let unstepped = match &r.unstepped {
-        Unstepped::Reconstruction(record) => Some(reconstruction::write(file, record)),
-        Unstepped::Elements(record) => Some(elements::write(file, record)),
-        Unstepped::ShapeFunctions(record) => Some(shape_functions::write(file, record)),
-        Unstepped::None => None,
+    // An unstepped run's file is its identity and its one group.
+    let written = match &r.unstepped {
+        Unstepped::Reconstruction(record) => reconstruction::write(file, record),
+        Unstepped::Elements(record) => elements::write(file, record),
+        Unstepped::ShapeFunctions(record) => shape_functions::write(file, record),
+        Unstepped::None => return write_stepped(file, r, stream),
     };
-    if let Some(written) = unstepped {
-        written?;
-        return file.flush();
-    }
+    written.and_then(|()| file.flush())
+}
+
+/// The particle, history, grid, error, conservation and probe groups of a stepped run.
+fn write_stepped(
+    file: &hdf5::File,
+    r: &RunRecord,
+    stream: Option<HistoryStream>,
+) -> hdf5::Result<()> {
     let d = r.dim;
     let np = r.particles.len();
     let nt = r.history.time.len();
