@@ -158,8 +158,9 @@ impl<const D: usize> DualDomain<D> {
                 let j = node[b] as usize;
                 let share = weight[b] * v;
                 self.volume[j] += share;
+                let average = &mut self.average[j * stride..(j + 1) * stride];
                 for a in 0..corners {
-                    self.average[j * stride + corner_offset::<D>(a, b)] += grad[a] * share;
+                    average[corner_offset::<D>(a, b)] += grad[a] * share;
                 }
             }
         }
@@ -271,33 +272,43 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         weight.fill(0.0);
         grad.fill(SVector::zeros());
         let base = grid.node_index(cell);
+        // Away from the grid's ends the block is centred on the cell and holds every
+        // neighbour of every corner, at entries fixed by the corner: no test per neighbour.
+        let centred = (0..D).all(|k| start[k] + 1 == cell[k]);
+        let steps = const { neighbour_steps::<D>() };
         for b in 0..1 << D {
-            // The hat of corner j = b of the cell, as `LinearHat` evaluates it, and the
-            // corner's coordinates in the block.
+            // The hat of corner j = b of the cell, as `LinearHat` evaluates it.
             let mut hat = 1.0;
             let mut j = base;
-            let mut local = [0; D];
+            let mut upper = [0; D];
             for k in 0..D {
-                let upper = b >> k & 1;
-                hat *= if upper == 1 { xi[k] } else { 1.0 - xi[k] };
-                j += upper * grid.stride(k);
-                local[k] = cell[k] + upper - start[k];
+                upper[k] = b >> k & 1;
+                hat *= if upper[k] == 1 { xi[k] } else { 1.0 - xi[k] };
+                j += upper[k] * grid.stride(k);
             }
-            let entry = block_entry::<D>(&local);
-            weight[entry] = hat;
-            // The neighbours i = j + o - 1 (o in {0, 1, 2}^D) that are in the block: those
-            // outside it are off the grid, where the averages are zero.
-            let reached = neighbours_in_block(&local);
-            let first = entry.wrapping_sub(const { block_entry::<D>(&[1; D]) });
-            let neighbours = self.average[j * stride..(j + 1) * stride]
+            // The neighbours i = j + o - 1 (o in {0, 1, 2}^D), from block entry `first`.
+            let averages = self.average[j * stride..(j + 1) * stride]
                 .iter()
-                .zip(&const { neighbour_steps::<D>() })
-                .enumerate();
-            // Away from the grid's ends every neighbour is in the block: no test.
-            let all = (1 << NEIGHBOURS_PER_AXIS.pow(D as u32)) - 1;
-            for (n, (average, step)) in neighbours {
-                if reached == all || reached >> n & 1 == 1 {
-                    grad[first.wrapping_add(*step)] += average * hat;
+                .zip(&steps);
+            if centred {
+                // The corner is block entry 1 + upper, its neighbours start at `upper`.
+                let first = block_entry::<D>(&upper);
+                weight[first + const { block_entry::<D>(&[1; D]) }] = hat;
+                for (average, step) in averages {
+                    grad[first + step] += average * hat;
+                }
+            } else {
+                // Neighbours outside the shifted block are off the grid, where the averages
+                // are zero.
+                let local: [usize; D] = std::array::from_fn(|k| cell[k] + upper[k] - start[k]);
+                let entry = block_entry::<D>(&local);
+                weight[entry] = hat;
+                let reached = neighbours_in_block(&local);
+                let first = entry.wrapping_sub(const { block_entry::<D>(&[1; D]) });
+                for (n, (average, step)) in averages.enumerate() {
+                    if reached >> n & 1 == 1 {
+                        grad[first.wrapping_add(*step)] += average * hat;
+                    }
                 }
             }
         }
