@@ -79,9 +79,11 @@ impl ConjugateGradients {
                 return Err(Breakdown::NotPositiveDefinite(pq));
             }
             let alpha = rz / pq;
-            for i in 0..n {
-                self.x[i] += alpha * self.p[i];
-                self.r[i] -= alpha * self.q[i];
+            // Zipped rather than indexed: no bounds checks, so the updates vectorise.
+            let updates = self.x.iter_mut().zip(&mut self.r).zip(&self.p).zip(&self.q);
+            for (((x, r), &p), &q) in updates {
+                *x += alpha * p;
+                *r -= alpha * q;
             }
             precondition(&self.r, &mut self.z);
             let rz_new = dot(&self.r, &self.z);
@@ -89,8 +91,8 @@ impl ConjugateGradients {
                 return Err(Breakdown::NotConverged(rz_new));
             }
             let beta = rz_new / rz;
-            for i in 0..n {
-                self.p[i] = self.z[i] + beta * self.p[i];
+            for (p, &z) in self.p.iter_mut().zip(&self.z) {
+                *p = z + beta * *p;
             }
             rz = rz_new;
         }

@@ -93,8 +93,8 @@ impl SymmetricDiagonals {
         for (s, &d) in self.distances.iter().enumerate() {
             let diagonal = &self.values[s * n..(s + 1) * n];
             if d == 0 {
-                for i in 0..n {
-                    y[i] += diagonal[i] * x[i];
+                for ((y, &a), &x) in y[..n].iter_mut().zip(diagonal).zip(&x[..n]) {
+                    *y += a * x;
                 }
                 continue;
             }
