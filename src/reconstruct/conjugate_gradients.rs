@@ -25,9 +25,9 @@ pub enum Breakdown {
     NotConverged(f64),
 }
 
-/// Work vectors, kept between solves.
+/// One right-hand side's work vectors, kept between solves.
 #[derive(Clone, Debug, Default)]
-pub struct ConjugateGradients {
+struct Column {
     x: Vec<f64>,
     r: Vec<f64>,
     z: Vec<f64>,
@@ -35,69 +35,124 @@ pub struct ConjugateGradients {
     q: Vec<f64>,
 }
 
+/// Work vectors of the right-hand sides solved together, kept between solves.
+#[derive(Clone, Debug, Default)]
+pub struct ConjugateGradients {
+    columns: Vec<Column>,
+}
+
 impl ConjugateGradients {
-    /// Solves M x = b on the DOFs where the preconditioner `precondition(r, z)` (z = P^-1 r,
-    /// symmetric and positive definite there) is nonzero, x zero elsewhere; `b` is
-    /// overwritten with x. Returns the iterations taken.
-    pub fn solve(
+    /// Solves M x_c = b_c for C right-hand sides on the DOFs where the preconditioner
+    /// `precondition(c, r, z)` (z = P_c^-1 r, symmetric and positive definite there) is
+    /// nonzero, x_c zero elsewhere; each `b[c]` is overwritten with x_c. Returns each column's
+    /// iterations. The columns run in lock step, each taking the steps and sums of a solve on
+    /// its own in the same order, so its x_c is the same to the bit; their dot products run in
+    /// one pass, where the chains of dependent additions overlap instead of following one
+    /// another.
+    pub fn solve_columns<const C: usize>(
         &mut self,
         matrix: &SymmetricDiagonals,
-        mut precondition: impl FnMut(&[f64], &mut [f64]),
-        b: &mut [f64],
-    ) -> Result<usize, Breakdown> {
+        mut precondition: impl FnMut(usize, &[f64], &mut [f64]),
+        mut b: [&mut [f64]; C],
+    ) -> [Result<usize, Breakdown>; C] {
         let n = matrix.order();
-        for v in [
-            &mut self.x,
-            &mut self.r,
-            &mut self.z,
-            &mut self.p,
-            &mut self.q,
-        ] {
-            v.clear();
-            v.resize(n, 0.0);
+        self.columns.resize_with(C, Column::default);
+        let columns = &mut self.columns[..C];
+        for (c, (column, b)) in columns.iter_mut().zip(&b).enumerate() {
+            for v in [
+                &mut column.x,
+                &mut column.r,
+                &mut column.z,
+                &mut column.p,
+                &mut column.q,
+            ] {
+                v.clear();
+                v.resize(n, 0.0);
+            }
+            // Entries off the DOFs never enter: z and so p, x are zero there.
+            column.r.copy_from_slice(&b[..n]);
+            precondition(c, &column.r, &mut column.z);
+            column.p.copy_from_slice(&column.z);
         }
-        // Entries off the DOFs never enter: z and so p, x are zero there.
-        self.r.copy_from_slice(&b[..n]);
-        precondition(&self.r, &mut self.z);
-        self.p.copy_from_slice(&self.z);
-        let mut rz = dot(&self.r, &self.z);
-        if !rz.is_finite() {
-            return Err(Breakdown::NotConverged(rz));
+        let mut rz = dots::<C>(columns, |c| (&c.r, &c.z));
+        // A column's outcome, once it has one; the others are still iterating.
+        let mut outcome: [Option<Result<usize, Breakdown>>; C] = [None; C];
+        let mut target = [0.0; C];
+        for c in 0..C {
+            if rz[c].is_finite() {
+                target[c] = rz[c] * RELATIVE_RESIDUAL * RELATIVE_RESIDUAL;
+            } else {
+                outcome[c] = Some(Err(Breakdown::NotConverged(rz[c])));
+            }
         }
-        let target = rz * RELATIVE_RESIDUAL * RELATIVE_RESIDUAL;
-        let mut iterations = 0;
-        while rz > target {
-            if iterations == MAX_ITERATIONS {
-                return Err(Breakdown::NotConverged(
-                    (rz / target).sqrt() * RELATIVE_RESIDUAL,
-                ));
+        let mut iterations = [0; C];
+        loop {
+            // The columns that take this iteration.
+            let mut stepping = [false; C];
+            for c in 0..C {
+                if outcome[c].is_some() {
+                    continue;
+                }
+                if rz[c] <= target[c] {
+                    outcome[c] = Some(Ok(iterations[c]));
+                } else if iterations[c] == MAX_ITERATIONS {
+                    let residual = (rz[c] / target[c]).sqrt() * RELATIVE_RESIDUAL;
+                    outcome[c] = Some(Err(Breakdown::NotConverged(residual)));
+                } else {
+                    iterations[c] += 1;
+                    matrix.multiply(&columns[c].p, &mut columns[c].q);
+                    stepping[c] = true;
+                }
             }
-            iterations += 1;
-            matrix.multiply(&self.p, &mut self.q);
-            let pq = dot(&self.p, &self.q);
-            if pq.is_nan() || pq <= 0.0 {
-                return Err(Breakdown::NotPositiveDefinite(pq));
+            if !stepping.contains(&true) {
+                break;
             }
-            let alpha = rz / pq;
-            // Zipped rather than indexed: no bounds checks, so the updates vectorise.
-            let updates = self.x.iter_mut().zip(&mut self.r).zip(&self.p).zip(&self.q);
-            for (((x, r), &p), &q) in updates {
-                *x += alpha * p;
-                *r -= alpha * q;
+            // The finished columns' products come along unused: their chains overlap the
+            // others' and cost about nothing.
+            let pq = dots::<C>(columns, |c| (&c.p, &c.q));
+            for c in 0..C {
+                if !stepping[c] {
+                    continue;
+                }
+                if pq[c].is_nan() || pq[c] <= 0.0 {
+                    outcome[c] = Some(Err(Breakdown::NotPositiveDefinite(pq[c])));
+                    stepping[c] = false;
+                    continue;
+                }
+                let alpha = rz[c] / pq[c];
+                let column = &mut columns[c];
+                // Zipped rather than indexed: no bounds checks, so the updates vectorise.
+                let updates = column.x.iter_mut().zip(&mut column.r);
+                for ((x, r), (&p, &q)) in updates.zip(column.p.iter().zip(&column.q)) {
+                    *x += alpha * p;
+                    *r -= alpha * q;
+                }
+                precondition(c, &column.r, &mut column.z);
             }
-            precondition(&self.r, &mut self.z);
-            let rz_new = dot(&self.r, &self.z);
-            if !rz_new.is_finite() {
-                return Err(Breakdown::NotConverged(rz_new));
+            let rz_new = dots::<C>(columns, |c| (&c.r, &c.z));
+            for c in 0..C {
+                if !stepping[c] {
+                    continue;
+                }
+                if !rz_new[c].is_finite() {
+                    outcome[c] = Some(Err(Breakdown::NotConverged(rz_new[c])));
+                    continue;
+                }
+                let beta = rz_new[c] / rz[c];
+                let column = &mut columns[c];
+                for (p, &z) in column.p.iter_mut().zip(&column.z) {
+                    *p = z + beta * *p;
+                }
+                rz[c] = rz_new[c];
             }
-            let beta = rz_new / rz;
-            for (p, &z) in self.p.iter_mut().zip(&self.z) {
-                *p = z + beta * *p;
-            }
-            rz = rz_new;
         }
-        b[..n].copy_from_slice(&self.x);
-        Ok(iterations)
+        std::array::from_fn(|c| {
+            let result = outcome[c].expect("every column ends with an outcome");
+            if result.is_ok() {
+                b[c][..n].copy_from_slice(&columns[c].x);
+            }
+            result
+        })
     }
 }
 
@@ -108,14 +163,44 @@ pub fn precondition_lumped(inverse_lumped: &[f64], r: &[f64], z: &mut [f64]) {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// a_c . b_c for each column's pair of vectors `pair(column)`, in one pass. Each sum starts
+/// from the value `Iterator::sum` starts from and adds its products in index order, as
+/// `a.iter().zip(b).map(|(x, y)| x * y).sum()` does, to the bit.
+fn dots<const C: usize>(
+    columns: &[Column],
+    pair: impl Fn(&Column) -> (&Vec<f64>, &Vec<f64>),
+) -> [f64; C] {
+    let pairs: [(&[f64], &[f64]); C] = std::array::from_fn(|c| {
+        let (a, b) = pair(&columns[c]);
+        (a.as_slice(), &b[..a.len()])
+    });
+    let mut sums = [std::iter::empty::<f64>().sum::<f64>(); C];
+    let n = pairs.first().map_or(0, |(a, _)| a.len());
+    for i in 0..n {
+        for (sum, (a, b)) in sums.iter_mut().zip(&pairs) {
+            *sum += a[i] * b[i];
+        }
+    }
+    sums
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
+
+    impl ConjugateGradients {
+        /// One right-hand side.
+        fn solve(
+            &mut self,
+            matrix: &SymmetricDiagonals,
+            mut precondition: impl FnMut(&[f64], &mut [f64]),
+            b: &mut [f64],
+        ) -> Result<usize, Breakdown> {
+            let [result] = self.solve_columns(matrix, |_, r, z| precondition(r, z), [b]);
+            result
+        }
+    }
 
     /// The consistent mass matrix of the 1D hat on `n` nodes of unit spacing with one unit
     /// mass per cell at its centre, and its row sums.
@@ -210,5 +295,99 @@ mod tests {
             matches!(result, Err(Breakdown::NotConverged(_))),
             "{result:?}"
         );
+    }
+
+    /// Columns solved together give each column's x and iteration count to the bit, whatever
+    /// the others do: here one converges in fewer iterations than the other, and one breaks
+    /// down.
+    #[test]
+    fn columns_solved_together_match_each_solved_alone() {
+        let n = 30;
+        let (mut matrix, lumped) = hat_mass(n);
+        for i in 0..n {
+            matrix.add(i, i, 0.05 * (1.0 + (i % 3) as f64));
+        }
+        let inverse: Vec<f64> = lumped.iter().map(|m| 1.0 / m).collect();
+        // The second column's preconditioner is the lumped one on every other DOF only.
+        let sparse: Vec<f64> = (0..n)
+            .map(|i| if i % 2 == 0 { inverse[i] } else { 0.0 })
+            .collect();
+        let precondition = |c: usize, r: &[f64], z: &mut [f64]| {
+            precondition_lumped(if c == 0 { &inverse } else { &sparse }, r, z)
+        };
+        let b0: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).cos()).collect();
+        let b1: Vec<f64> = (0..n).map(|i| 0.3 * (i % 5) as f64).collect();
+        let alone: Vec<(Vec<f64>, Result<usize, Breakdown>)> = [&b0, &b1]
+            .iter()
+            .enumerate()
+            .map(|(c, b)| {
+                let mut x = b.to_vec();
+                let result = ConjugateGradients::default().solve(
+                    &matrix,
+                    |r, z| precondition(c, r, z),
+                    &mut x,
+                );
+                (x, result)
+            })
+            .collect();
+        assert_ne!(
+            alone[0].1, alone[1].1,
+            "the columns should differ in iterations"
+        );
+        let (mut x0, mut x1) = (b0.clone(), b1.clone());
+        let together = ConjugateGradients::default().solve_columns(
+            &matrix,
+            precondition,
+            [&mut x0[..], &mut x1[..]],
+        );
+        for (c, x) in [x0, x1].iter().enumerate() {
+            assert_eq!(together[c], alone[c].1, "column {c}");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(x), bits(&alone[c].0), "column {c}");
+        }
+        // A column that breaks down leaves the other's solution as it is alone.
+        let mut indefinite = SymmetricDiagonals::default();
+        indefinite.reset(2, 1);
+        indefinite.add(0, 0, 1.0);
+        indefinite.add(1, 1, -1.0);
+        let (mut y0, mut y1) = (vec![1.0, 0.0], vec![0.0, 1.0]);
+        let ones = [1.0, 1.0];
+        let [first, second] = ConjugateGradients::default().solve_columns(
+            &indefinite,
+            |_, r, z| precondition_lumped(&ones, r, z),
+            [&mut y0[..], &mut y1[..]],
+        );
+        assert_eq!(first, Ok(1));
+        assert_eq!(y0, [1.0, 0.0]);
+        assert!(
+            matches!(second, Err(Breakdown::NotPositiveDefinite(_))),
+            "{second:?}"
+        );
+    }
+
+    /// `dots` sums as `Iterator::sum` does, from its starting value: a sum of negative zeros
+    /// keeps the sign it gets there.
+    #[test]
+    fn dots_match_the_iterator_sum_to_the_bit() {
+        let column = |a: Vec<f64>, b: Vec<f64>| Column {
+            x: a,
+            r: b,
+            ..Column::default()
+        };
+        let columns = [
+            column(vec![-0.0, -0.0], vec![1.0, 2.0]),
+            column(vec![0.1, 0.2, 0.3], vec![3.0, -1.0, 7.0]),
+        ];
+        let sums = dots::<1>(&columns[..1], |c| (&c.x, &c.r));
+        let expected: f64 = [-0.0f64, -0.0].iter().map(|x| x * 1.0).sum();
+        assert_eq!(sums[0].to_bits(), expected.to_bits());
+        let sums = dots::<1>(&columns[1..], |c| (&c.x, &c.r));
+        let expected: f64 = columns[1]
+            .x
+            .iter()
+            .zip(&columns[1].r)
+            .map(|(x, y)| x * y)
+            .sum();
+        assert_eq!(sums[0].to_bits(), expected.to_bits());
     }
 }

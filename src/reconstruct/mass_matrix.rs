@@ -56,7 +56,8 @@ pub struct MassSolver<const D: usize> {
     lines: Vec<LineSums>,
     with_lines: [bool; D],
     iterations: ConjugateGradients,
-    rhs: Vec<f64>,
+    /// Per component its right-hand side, then its solution.
+    rhs: [Vec<f64>; D],
     /// sum_i p_i of the last `solve_momenta`: the momentum the DOFs received.
     received: SVector<f64, D>,
 }
@@ -82,7 +83,7 @@ impl<const D: usize> MassSolver<D> {
             lines: vec![LineSums::default(); D],
             with_lines: [false; D],
             iterations: ConjugateGradients::default(),
-            rhs: Vec::new(),
+            rhs: std::array::from_fn(|_| Vec::new()),
             received: SVector::zeros(),
         }
     }
@@ -247,11 +248,10 @@ impl<const D: usize> MassSolver<D> {
             }
             return Ok(());
         }
-        let rhs = &mut self.rhs;
-        for k in 0..D {
-            rhs.clear();
-            if self.direct {
+        if self.direct {
+            for (k, rhs) in self.rhs.iter_mut().enumerate() {
                 let free = &self.free[k];
+                rhs.clear();
                 rhs.extend(free.iter().map(|&i| field[i as usize][k]));
                 self.factors[self.factor_of[k]].solve(rhs);
                 for x in field.iter_mut() {
@@ -260,24 +260,32 @@ impl<const D: usize> MassSolver<D> {
                 for (&i, &x) in free.iter().zip(rhs.iter()) {
                     field[i as usize][k] = x;
                 }
-            } else {
-                rhs.extend(field.iter().map(|x| x[k]));
-                let solved = if self.with_lines[k] {
-                    let lines = &mut self.lines[k];
-                    self.iterations
-                        .solve(&self.matrix, |r, z| lines.apply(r, z), rhs)
+            }
+            return Ok(());
+        }
+        for (k, rhs) in self.rhs.iter_mut().enumerate() {
+            rhs.clear();
+            rhs.extend(field.iter().map(|x| x[k]));
+        }
+        // The components together, each with its own preconditioner.
+        let (lines, inverse_lumped, with_lines) =
+            (&mut self.lines, &self.inverse_lumped, self.with_lines);
+        let solved = self.iterations.solve_columns(
+            &self.matrix,
+            |k, r, z| {
+                if with_lines[k] {
+                    lines[k].apply(r, z);
                 } else {
-                    let inverse = &self.inverse_lumped[k];
-                    self.iterations.solve(
-                        &self.matrix,
-                        |r, z| precondition_lumped(inverse, r, z),
-                        rhs,
-                    )
-                };
-                solved.map_err(breakdown_message)?;
-                for (x, &value) in field.iter_mut().zip(rhs.iter()) {
-                    x[k] = value;
+                    precondition_lumped(&inverse_lumped[k], r, z);
                 }
+            },
+            self.rhs.each_mut().map(Vec::as_mut_slice),
+        );
+        // The first component that broke down, as solving them one after another reports it.
+        for (k, (solved, rhs)) in solved.into_iter().zip(&self.rhs).enumerate() {
+            solved.map_err(breakdown_message)?;
+            for (x, &value) in field.iter_mut().zip(rhs) {
+                x[k] = value;
             }
         }
         Ok(())
