@@ -1,7 +1,8 @@
 //! Local least-squares reconstruction of particle data at a lattice of evaluation points
 //! (Gong sec 3.5, Tran eqs 1-17): u^h(x_e) = sum_p phi_p(x_e) u_p with
-//! phi_p(x_e) = w(x_e - x_p) q((x_p - x_e)/h) . c_e. The fit (moments, solve, shape
-//! functions) is done once per particle configuration and applied to any number of fields.
+//! phi_p(x_e) = w(x_e - x_p) q((x_p - x_e)/h) . c_e. The fit (weights, moments, solve) is
+//! done once per particle configuration and applied to any number of fields, each
+//! application forming the shape functions as it goes.
 
 use std::fmt;
 use std::ops::{AddAssign, Mul};
@@ -105,8 +106,8 @@ pub struct Reconstructor<const D: usize> {
     point: Vec<u32>,
     /// (x_p - x_e)/h of each entry.
     offset: Vec<SVector<f64, D>>,
-    /// The weight w(x_e - x_p) after pass one, the shape function phi_p(x_e) after the fit.
-    phi: Vec<f64>,
+    /// The weight w(x_e - x_p) of each entry, from which `apply` forms phi_p(x_e).
+    weight: Vec<f64>,
     /// Per evaluation point, its moment matrix packed as `packed_len` describes, then its c_e.
     moments: Vec<f64>,
     coeffs: Vec<f64>,
@@ -131,7 +132,7 @@ impl<const D: usize> Reconstructor<D> {
             start: Vec::new(),
             point: Vec::new(),
             offset: Vec::new(),
-            phi: Vec::new(),
+            weight: Vec::new(),
             moments: vec![0.0; points * packed_len(terms)],
             coeffs: vec![0.0; points * terms],
             covered: vec![false; points],
@@ -173,9 +174,7 @@ impl<const D: usize> Reconstructor<D> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
         debug_assert_eq!(P, packed_len(T));
         self.gather_weights::<T, P>(x);
-        let stats = self.solve::<T, P>()?;
-        self.finish_shape_functions::<T>();
-        Ok(stats)
+        self.solve::<T, P>()
     }
 
     /// Pass one: the lattice points each particle reaches, their weights and offsets, and
@@ -185,12 +184,16 @@ impl<const D: usize> Reconstructor<D> {
         let capacity = x.len() * self.max_entries;
         self.point.resize(capacity, 0);
         self.offset.resize(capacity, SVector::zeros());
-        self.phi.resize(capacity, 0.0);
+        self.weight.resize(capacity, 0.0);
         self.start.resize(x.len() + 1, 0);
         self.moments.fill(0.0);
         // Borrowed apart so the loop keeps them in registers.
         let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
-        let (point, offset, phi) = (&mut self.point[..], &mut self.offset[..], &mut self.phi[..]);
+        let (point, offset, weights) = (
+            &mut self.point[..],
+            &mut self.offset[..],
+            &mut self.weight[..],
+        );
         let (start, moments) = (&mut self.start[..], self.moments.as_chunks_mut::<P>().0);
         let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
         // Per axis and neighbour: the part of the lattice index, the offset and the 1D
@@ -221,9 +224,9 @@ impl<const D: usize> Reconstructor<D> {
                 let rows = point[entry..][..total]
                     .chunks_exact_mut(along)
                     .zip(offset[entry..][..total].chunks_exact_mut(along))
-                    .zip(phi[entry..][..total].chunks_exact_mut(along));
+                    .zip(weights[entry..][..total].chunks_exact_mut(along));
                 let mut j = [0usize; D];
-                for ((row_point, row_offset), row_phi) in rows {
+                for ((row_point, row_offset), row_weight) in rows {
                     let mut row_index = 0;
                     let mut d = SVector::<f64, D>::zeros();
                     for k in 1..D {
@@ -234,7 +237,7 @@ impl<const D: usize> Reconstructor<D> {
                         .iter()
                         .zip(&axis_offset[0][..along])
                         .zip(&axis_weight[0][..along]);
-                    let entries = row_point.iter_mut().zip(row_offset).zip(row_phi);
+                    let entries = row_point.iter_mut().zip(row_offset).zip(row_weight);
                     for (((e, d_out), w_out), ((&i, &d0), &w0)) in entries.zip(first) {
                         let mut w = w0;
                         for k in 1..D {
@@ -298,38 +301,45 @@ impl<const D: usize> Reconstructor<D> {
         Ok(stats)
     }
 
-    /// Pass two: phi_p(x_e) = w q((x_p - x_e)/h) . c_e for every entry.
-    fn finish_shape_functions<const T: usize>(&mut self) {
-        let mut q = [0.0; MAX_TERMS];
-        let degree = degree_of::<T, D>();
-        let entries = self.start.last().copied().unwrap_or(0);
-        let phis = &mut self.phi[..entries];
-        let coeffs = self.coeffs.as_chunks::<T>().0;
-        for ((phi, &e), d) in phis.iter_mut().zip(&self.point).zip(&self.offset) {
-            let w = *phi;
-            if w == 0.0 {
-                continue;
-            }
-            monomials(degree, d, &mut q);
-            let c = &coeffs[e as usize];
-            *phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
+    /// u^h at every evaluation point from particle values `values` (same order as the fit),
+    /// with each entry's shape function phi_p(x_e) = w q((x_p - x_e)/h) . c_e taken as it is
+    /// used: a fit applied once (the leapfrog steps) does not store and reread it.
+    pub fn apply<V>(&self, values: &[V], out: &mut [V])
+    where
+        V: Copy + Zero + AddAssign + Mul<f64, Output = V>,
+    {
+        match self.terms {
+            1 => self.apply_with::<1, V>(values, out),
+            2 => self.apply_with::<2, V>(values, out),
+            3 => self.apply_with::<3, V>(values, out),
+            MAX_TERMS => self.apply_with::<MAX_TERMS, V>(values, out),
+            t => unreachable!("no basis has {t} terms"),
         }
     }
 
-    /// u^h at every evaluation point from particle values `values` (same order as the fit).
-    pub fn apply<T>(&self, values: &[T], out: &mut [T])
+    fn apply_with<const T: usize, V>(&self, values: &[V], out: &mut [V])
     where
-        T: Copy + Zero + AddAssign + Mul<f64, Output = T>,
+        V: Copy + Zero + AddAssign + Mul<f64, Output = V>,
     {
-        out.fill(T::zero());
+        out.fill(V::zero());
         assert!(
             values.len() < self.start.len(),
             "more values than fitted particles"
         );
-        let (point, phi) = (&self.point[..], &self.phi[..]);
+        let degree = degree_of::<T, D>();
+        let coeffs = self.coeffs.as_chunks::<T>().0;
+        let mut q = [0.0; MAX_TERMS];
         for (&value, ends) in values.iter().zip(self.start.windows(2)) {
             let entries = ends[0]..ends[1];
-            for (&e, &phi) in point[entries.clone()].iter().zip(&phi[entries]) {
+            let point = &self.point[entries.clone()];
+            let offset = &self.offset[entries.clone()];
+            for ((&e, &w), d) in point.iter().zip(&self.weight[entries]).zip(offset) {
+                if w == 0.0 {
+                    continue;
+                }
+                monomials(degree, d, &mut q);
+                let c = &coeffs[e as usize];
+                let phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
                 if phi != 0.0 {
                     out[e as usize] += value * phi;
                 }
