@@ -168,11 +168,11 @@ pub fn precondition_lumped(inverse_lumped: &[f64], r: &[f64], z: &mut [f64]) {
 /// `a.iter().zip(b).map(|(x, y)| x * y).sum()` does, to the bit.
 fn dots<const C: usize>(
     columns: &[Column],
-    pair: impl Fn(&Column) -> (&Vec<f64>, &Vec<f64>),
+    pair: impl Fn(&Column) -> (&[f64], &[f64]),
 ) -> [f64; C] {
     let pairs: [(&[f64], &[f64]); C] = std::array::from_fn(|c| {
         let (a, b) = pair(&columns[c]);
-        (a.as_slice(), &b[..a.len()])
+        (a, &b[..a.len()])
     });
     let mut sums = [std::iter::empty::<f64>().sum::<f64>(); C];
     let n = pairs.first().map_or(0, |(a, _)| a.len());

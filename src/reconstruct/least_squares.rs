@@ -332,8 +332,9 @@ impl<const D: usize> Reconstructor<D> {
         for (&value, ends) in values.iter().zip(self.start.windows(2)) {
             let entries = ends[0]..ends[1];
             let point = &self.point[entries.clone()];
-            let offset = &self.offset[entries.clone()];
-            for ((&e, &w), d) in point.iter().zip(&self.weight[entries]).zip(offset) {
+            let weight = &self.weight[entries.clone()];
+            let offset = &self.offset[entries];
+            for ((&e, &w), d) in point.iter().zip(weight).zip(offset) {
                 if w == 0.0 {
                     continue;
                 }

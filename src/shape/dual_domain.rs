@@ -274,6 +274,8 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
         let base = grid.node_index(cell);
         // Away from the grid's ends the block is centred on the cell and holds every
         // neighbour of every corner, at entries fixed by the corner: no test per neighbour.
+        // A path of its own, not a full mask on the shifted path: with the mask `ddmpm`'s
+        // 16-step 2D case takes 755 M instructions instead of 704 M.
         let centred = (0..D).all(|k| start[k] + 1 == cell[k]);
         let steps = const { neighbour_steps::<D>() };
         for b in 0..1 << D {
