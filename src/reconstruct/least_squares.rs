@@ -283,7 +283,7 @@ impl<const D: usize> Reconstructor<D> {
             match self.recipe.solver {
                 Solver::Mls => {
                     let solved =
-                        mls_coefficients(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
+                        mls_coefficients::<T>(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
                             point: e,
                             position: self.lattice.point(e).iter().copied().collect(),
                         })?;

@@ -115,6 +115,19 @@ impl<const S: usize> Orthogonal<S> {
         basis
     }
 
+    /// This basis in `wide`, sized for more terms: a copy the size of this basis, not of
+    /// `wide`, whose entries from `S` on keep what they held (every use stops at `terms`).
+    #[inline(always)]
+    pub(super) fn copy_into<const W: usize>(&self, wide: &mut Orthogonal<W>) {
+        debug_assert!(S <= W);
+        wide.terms = self.terms;
+        for i in 0..S {
+            wide.coeffs[i][..S].copy_from_slice(&self.coeffs[i]);
+        }
+        wide.norms[..S].copy_from_slice(&self.norms);
+        wide.kept[..S].copy_from_slice(&self.kept);
+    }
+
     pub fn rank(&self) -> usize {
         self.kept[..self.terms].iter().filter(|&&k| k).count()
     }
@@ -201,46 +214,47 @@ fn quadratic_form<const S: usize>(a: &[f64], stride: usize, c: &[f64; S], n: usi
 /// the largest diagonal entry. Always inlined so that callers with a fixed basis size get
 /// the loops unrolled.
 #[inline(always)]
-pub fn mls_coefficients(a: &[f64], stride: usize, terms: usize) -> Option<[f64; MAX_TERMS]> {
+pub fn mls_coefficients<const S: usize>(
+    a: &[f64],
+    stride: usize,
+    terms: usize,
+) -> Option<[f64; S]> {
     let n = terms;
+    debug_assert!(n <= S);
     let scale = (0..n).map(|i| a[i * stride + i]).fold(0.0, f64::max);
-    let mut m = [0.0; MAX_TERMS * MAX_TERMS];
+    // S x S, the basis size where it is a constant: zeroing the largest size is a memset
+    // call per evaluation point.
+    let mut m = [[0.0; S]; S];
     for r in 0..n {
-        m[r * MAX_TERMS..r * MAX_TERMS + n].copy_from_slice(&a[r * stride..r * stride + n]);
+        m[r][..n].copy_from_slice(&a[r * stride..r * stride + n]);
     }
-    let mut rhs = [0.0; MAX_TERMS];
+    let mut rhs = [0.0; S];
     rhs[0] = 1.0;
     for col in 0..n {
         let pivot = (col..n)
-            .max_by(|&r, &s| {
-                m[r * MAX_TERMS + col]
-                    .abs()
-                    .total_cmp(&m[s * MAX_TERMS + col].abs())
-            })
+            .max_by(|&r, &s| m[r][col].abs().total_cmp(&m[s][col].abs()))
             .expect("non-empty range");
-        let p = m[pivot * MAX_TERMS + col];
+        let p = m[pivot][col];
         // NaN moments are singular too.
         if p.abs() <= RANK_TOLERANCE * scale || p.is_nan() {
             return None;
         }
         if pivot != col {
-            for j in 0..n {
-                m.swap(col * MAX_TERMS + j, pivot * MAX_TERMS + j);
-            }
+            m.swap(col, pivot);
             rhs.swap(col, pivot);
         }
         for r in col + 1..n {
-            let factor = m[r * MAX_TERMS + col] / p;
+            let factor = m[r][col] / p;
             for j in col..n {
-                m[r * MAX_TERMS + j] -= factor * m[col * MAX_TERMS + j];
+                m[r][j] -= factor * m[col][j];
             }
             rhs[r] -= factor * rhs[col];
         }
     }
-    let mut c = [0.0; MAX_TERMS];
+    let mut c = [0.0; S];
     for r in (0..n).rev() {
-        let tail: f64 = (r + 1..n).map(|j| m[r * MAX_TERMS + j] * c[j]).sum();
-        c[r] = (rhs[r] - tail) / m[r * MAX_TERMS + r];
+        let tail: f64 = (r + 1..n).map(|j| m[r][j] * c[j]).sum();
+        c[r] = (rhs[r] - tail) / m[r][r];
     }
     Some(c)
 }

@@ -27,7 +27,7 @@ use std::fmt;
 use nalgebra::SVector;
 
 use super::basis::{Degree, MAX_TERMS};
-use super::solve::{add_weighted_outer, Fitted, Moments, OrthogonalBasis};
+use super::solve::{add_weighted_outer, Fitted, Orthogonal, OrthogonalBasis};
 
 /// The largest Taylor basis: the complete quadratic in 2D.
 pub const MAX_TAYLOR_TERMS: usize = MAX_TERMS;
@@ -198,28 +198,28 @@ impl<const D: usize> TaylorFit<D> {
         self.psi
             .extend(points.iter().map(|x| cell.basis(requested, x)));
         // The number of fitted functions as a constant lets the loops over them unroll.
-        let mut basis = match terms - prescribed {
-            0 => normal_basis::<0>(&self.psi, prescribed),
-            1 => normal_basis::<1>(&self.psi, prescribed),
-            2 => normal_basis::<2>(&self.psi, prescribed),
-            3 => normal_basis::<3>(&self.psi, prescribed),
-            4 => normal_basis::<4>(&self.psi, prescribed),
-            5 => normal_basis::<5>(&self.psi, prescribed),
-            MAX_TERMS => normal_basis::<MAX_TERMS>(&self.psi, prescribed),
+        let (psi, basis) = (&self.psi, &mut self.basis);
+        match terms - prescribed {
+            0 => normal_basis::<0>(psi, prescribed, basis),
+            1 => normal_basis::<1>(psi, prescribed, basis),
+            2 => normal_basis::<2>(psi, prescribed, basis),
+            3 => normal_basis::<3>(psi, prescribed, basis),
+            4 => normal_basis::<4>(psi, prescribed, basis),
+            5 => normal_basis::<5>(psi, prescribed, basis),
+            MAX_TERMS => normal_basis::<MAX_TERMS>(psi, prescribed, basis),
             f => unreachable!("no Taylor fit has {f} fitted functions"),
-        };
+        }
         // The first unsupported function caps the degree below its own; the polynomials before
         // it do not depend on the ones after it, so the factorisation truncates.
         let supported = (0..terms - prescribed)
-            .find(|&i| !basis.kept[i])
+            .find(|&i| !self.basis.kept[i])
             .map_or(requested, |i| {
                 term_degree(D, i + prescribed).saturating_sub(1)
             });
         self.degree = supported;
         self.prescribed = prescribed;
         self.terms = taylor_terms(D, supported);
-        basis.terms = self.terms - prescribed;
-        self.basis = basis;
+        self.basis.terms = self.terms - prescribed;
         supported
     }
 
@@ -289,14 +289,22 @@ impl<const D: usize> TaylorFit<D> {
     }
 }
 
-/// The orthogonal polynomials of the normal matrix sum_p psi psi^T of the `N` functions from
-/// `first` on, summed point by point in order.
-fn normal_basis<const N: usize>(psi: &[[f64; MAX_TAYLOR_TERMS]], first: usize) -> OrthogonalBasis {
-    let mut normal: Moments = [0.0; MAX_TERMS * MAX_TERMS];
+/// Into `basis`, the orthogonal polynomials of the normal matrix sum_p psi psi^T of the `N`
+/// functions from `first` on, summed point by point in order.
+fn normal_basis<const N: usize>(
+    psi: &[[f64; MAX_TAYLOR_TERMS]],
+    first: usize,
+    basis: &mut OrthogonalBasis,
+) {
+    // N x N, not the largest size: zeroing that much is a memset call per fit.
+    let mut normal = [[0.0; N]; N];
+    let normal = normal.as_flattened_mut();
     for psi in psi {
-        add_weighted_outer(&mut normal, MAX_TERMS, 1.0, &psi[first..][..N]);
+        add_weighted_outer(normal, N, 1.0, &psi[first..][..N]);
     }
-    OrthogonalBasis::from_rows(&normal, MAX_TERMS, N)
+    // Sized N and widened: built in the stored basis, or returned as one, it was copied
+    // whole with a memcpy call per fit.
+    Orthogonal::<N>::from_rows(normal, N, N).copy_into(basis);
 }
 
 #[cfg(test)]

@@ -181,7 +181,7 @@ fn imls_degrades_to_the_rank_of_the_data() {
         );
         // MLS has no such fallback: the same data make its moment matrix singular.
         assert_eq!(
-            super::solve::mls_coefficients(&a, MAX_TERMS, terms).is_some(),
+            super::solve::mls_coefficients::<MAX_TERMS>(&a, MAX_TERMS, terms).is_some(),
             rank == terms
         );
     }
