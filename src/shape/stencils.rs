@@ -119,11 +119,12 @@ impl<const D: usize> Stencils<D> {
             }
             Ok(())
         };
-        parallel::map_chunks(chunks, evaluate)
+        let outcome = parallel::map_chunks(chunks, evaluate)
             .into_iter()
-            .collect::<Result<(), usize>>()?;
+            .collect::<Result<(), usize>>();
+        // Kept on failure too, as the stencils are: taken above, they would be lost.
         self.values = values;
-        Ok(())
+        outcome
     }
 
     /// Adds the contributions of points `0..points` to nodal arrays cut into blocks of
