@@ -61,70 +61,84 @@ impl<const D: usize> Stencils<D> {
     ) -> Result<(), usize> {
         let k = self.per_point;
         let len = k * parallel::CHUNK;
-        let value_nodes = shape.value_nodes_per_point();
-        let mut values = (value_nodes < k).then(|| {
-            let points = self.node.len() / k;
-            match self.values.take() {
-                Some(values) if values.node.len() == value_nodes * points => values,
-                _ => Box::new(Stencils::new(value_nodes, points)),
-            }
-        });
-        // Each chunk's value entries, or `None` for every chunk where the basis has no
-        // separate ones.
-        let value_chunks = values
-            .as_deref_mut()
-            .map(|v| {
-                let len = value_nodes * parallel::CHUNK;
-                v.node.chunks_mut(len).zip(v.weight.chunks_mut(len))
-            })
-            .into_iter()
-            .flatten()
-            .map(Some)
-            .chain(std::iter::repeat_with(|| None));
         let chunks = self
             .node
             .chunks_mut(len)
             .zip(self.weight.chunks_mut(len))
             .zip(self.grad.chunks_mut(len))
             .zip(positions.chunks(parallel::CHUNK))
-            .zip(value_chunks)
             .enumerate();
         type Chunk<'a, const D: usize> = (
             usize,
             (
-                (
-                    ((&'a mut [u32], &'a mut [f64]), &'a mut [SVector<f64, D>]),
-                    &'a [SVector<f64, D>],
-                ),
-                Option<(&'a mut [u32], &'a mut [f64])>,
+                ((&'a mut [u32], &'a mut [f64]), &'a mut [SVector<f64, D>]),
+                &'a [SVector<f64, D>],
             ),
         );
-        let evaluate = |(c, ((((node, weight), grad), positions), values)): Chunk<D>| {
+        let evaluate = |(c, (((node, weight), grad), positions)): Chunk<D>| {
             let entries = node
                 .chunks_exact_mut(k)
                 .zip(weight.chunks_exact_mut(k))
                 .zip(grad.chunks_exact_mut(k));
-            let mut values = values.map(|(node, weight)| {
-                node.chunks_exact_mut(value_nodes)
-                    .zip(weight.chunks_exact_mut(value_nodes))
-            });
             for (q, ((node, weight), grad)) in entries.enumerate() {
                 if !shape.eval(grid, &positions[q], node, weight, grad) {
                     return Err(c * parallel::CHUNK + q);
                 }
-                // While the point's entries are in cache, not in a pass of their own.
-                if let Some((to_node, to_weight)) = values.as_mut().and_then(Iterator::next) {
-                    copy_values(node, weight, to_node, to_weight);
-                }
             }
             Ok(())
         };
-        let outcome = parallel::map_chunks(chunks, evaluate)
+        parallel::map_chunks(chunks, evaluate)
             .into_iter()
-            .collect::<Result<(), usize>>();
-        // Kept on failure too, as the stencils are: taken above, they would be lost.
-        self.values = values;
-        outcome
+            .collect::<Result<(), usize>>()?;
+        let value_nodes = shape.value_nodes_per_point();
+        if value_nodes < k {
+            let points = self.node.len() / k;
+            let mut values = match self.values.take() {
+                Some(values) if values.node.len() == value_nodes * points => values,
+                _ => Box::new(Stencils::new(value_nodes, points)),
+            };
+            self.copy_values_to(&mut values);
+            self.values = Some(values);
+        } else {
+            self.values = None;
+        }
+        Ok(())
+    }
+
+    /// Each point's entries with nonzero values into `values` (`values.per_point` of them per
+    /// point), in stencil order, the rest of its entries zero values at the point's first node.
+    fn copy_values_to(&self, values: &mut Stencils<D>) {
+        let (k, v) = (self.per_point, values.per_point);
+        let targets = values
+            .node
+            .chunks_mut(v * parallel::CHUNK)
+            .zip(values.weight.chunks_mut(v * parallel::CHUNK));
+        let sources = self
+            .node
+            .chunks(k * parallel::CHUNK)
+            .zip(self.weight.chunks(k * parallel::CHUNK));
+        type Target<'a> = (&'a mut [u32], &'a mut [f64]);
+        type Source<'a> = (&'a [u32], &'a [f64]);
+        let copy = |((to_node, to_weight), (node, weight)): (Target, Source)| {
+            let points = to_node
+                .chunks_exact_mut(v)
+                .zip(to_weight.chunks_exact_mut(v))
+                .zip(node.chunks_exact(k))
+                .zip(weight.chunks_exact(k));
+            for (((to_node, to_weight), node), weight) in points {
+                // Each entry written once: filling the padding first made a memset call of
+                // a few bytes per point.
+                let mut nonzero = node.iter().zip(weight).filter(|(_, &w)| w != 0.0);
+                for (to_node, to_weight) in to_node.iter_mut().zip(to_weight.iter_mut()) {
+                    (*to_node, *to_weight) = match nonzero.next() {
+                        Some((&i, &w)) => (i, w),
+                        None => (node[0], 0.0),
+                    };
+                }
+                debug_assert!(nonzero.next().is_none());
+            }
+        };
+        parallel::map_chunks(targets.zip(sources), copy);
     }
 
     /// Adds the contributions of points `0..points` to nodal arrays cut into blocks of
@@ -229,21 +243,6 @@ impl<const D: usize> Stencils<D> {
 
 /// Asserts that the gradients `shape` gives at `x` agree with central differences of its
 /// values within `tolerance`; `x` must be away from cell faces, where values have kinks.
-/// One point's entries with nonzero values into `to_node` and `to_weight`, in stencil order,
-/// the rest of them zero values at the point's first node.
-fn copy_values(node: &[u32], weight: &[f64], to_node: &mut [u32], to_weight: &mut [f64]) {
-    // Each entry written once: filling the padding first made a memset call of a few bytes
-    // per point.
-    let mut nonzero = node.iter().zip(weight).filter(|(_, &w)| w != 0.0);
-    for (to_node, to_weight) in to_node.iter_mut().zip(to_weight.iter_mut()) {
-        (*to_node, *to_weight) = match nonzero.next() {
-            Some((&i, &w)) => (i, w),
-            None => (node[0], 0.0),
-        };
-    }
-    debug_assert!(nonzero.next().is_none());
-}
-
 #[cfg(test)]
 pub(crate) fn assert_gradient_matches_differences<S: Shape<D> + ?Sized, const D: usize>(
     shape: &S,
