@@ -37,10 +37,10 @@ impl<const D: usize> ConsistentMassTransfer<D> {
     ) -> Result<(), Divergence> {
         particle_sums(stencils, particles, body_force, grid);
         self.solver.reset(stencils.bandwidth());
-        for p in 0..particles.len() {
-            let (nodes, values) = stencils.for_values().values_of(p);
-            self.solver.add_point(nodes, values, particles.mass[p]);
-        }
+        self.solver
+            .add_points(stencils.for_values(), 0..particles.len(), |p| {
+                particles.mass[p]
+            });
         self.solver.prepare(&grid.mass, grid.empty_mass)?;
         self.solver
             .solve_momenta(&grid.mass, grid.empty_mass, &mut grid.velocity)

@@ -66,14 +66,33 @@ impl SymmetricDiagonals {
         self.values[s as usize * self.n + row] += value;
     }
 
+    /// Where entry (i, j) is stored (`i` and `j` in either order), for `stored_value` and
+    /// `store`; None off the stored diagonals.
+    #[inline]
+    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let (row, d) = if i >= j { (i, i - j) } else { (j, j - i) };
+        match self.slot.get(d) {
+            Some(&s) if s != UNUSED => Some(s as usize * self.n + row),
+            _ => None,
+        }
+    }
+
+    /// The entry at a `position`.
+    #[inline]
+    pub fn stored_value(&self, position: usize) -> f64 {
+        self.values[position]
+    }
+
+    /// Sets the entry at a `position` (and its symmetric twin) to `value`.
+    #[inline]
+    pub fn store(&mut self, position: usize, value: f64) {
+        self.values[position] = value;
+    }
+
     /// Entry (i, j), `i` and `j` in either order; zero off the stored diagonals.
     #[inline]
     pub fn get(&self, i: usize, j: usize) -> f64 {
-        let (row, d) = if i >= j { (i, i - j) } else { (j, j - i) };
-        match self.slot.get(d) {
-            Some(&s) if s != UNUSED => self.values[s as usize * self.n + row],
-            _ => 0.0,
-        }
+        self.position(i, j).map_or(0.0, |at| self.values[at])
     }
 
     /// The stored diagonals of the lower triangle in the order of `distances`: each distance d

@@ -39,6 +39,8 @@ pub struct TaylorTransfer<const D: usize> {
     /// Weight of local Gauss point q, the same in every element.
     gauss_w: Vec<f64>,
     per_element: usize,
+    /// Scratch: rho times the quadrature weight at each Gauss point of one element.
+    point_scales: Vec<f64>,
     /// Sub-diagonals of the mass matrix in DOF numbering.
     bandwidth: usize,
     /// Particles sorted by element (a counting sort, stable in particle order).
@@ -102,6 +104,7 @@ impl<const D: usize> TaylorTransfer<D> {
             gauss_x,
             gauss_w,
             per_element,
+            point_scales: vec![0.0; per_element],
             bandwidth,
             element_of: Vec::new(),
             element_start: vec![0; elements + 1],
@@ -182,9 +185,17 @@ impl<const D: usize> TaylorTransfer<D> {
                     grid.force[i] -= sigma_g * grad;
                 }
                 if consistent {
-                    let (nodes, values) = self.basis.values_of(g);
-                    self.mass_solver.add_point(nodes, values, rho_g);
+                    self.point_scales[q] = rho_g;
                 }
+            }
+            if consistent {
+                let first = e * self.per_element;
+                let scales = &self.point_scales;
+                self.mass_solver.add_points(
+                    self.basis.for_values(),
+                    first..first + self.per_element,
+                    |g| scales[g - first],
+                );
             }
         }
         for p in 0..particles.len() {
