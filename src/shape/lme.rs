@@ -36,6 +36,12 @@ pub const RESIDUAL_TOLERANCE: f64 = 1e-12;
 /// studies need at most 196 (gamma 0.3 in 2D).
 pub const MAX_STENCIL_NODES: usize = 1024;
 
+/// The most nodes per axis of a 2D stencil block: MAX_STENCIL_NODES is 32 x 32.
+const MAX_SIDE_2D: usize = 32;
+
+/// Below this sum of the exponentials taken by rows, they are taken node by node instead.
+const MIN_Z_BY_ROWS: f64 = 1e-200;
+
 /// Sufficient-decrease factor of the Armijo test on log Z.
 const ARMIJO: f64 = 1e-4;
 
@@ -378,6 +384,8 @@ impl<const D: usize> LocalMaxEnt<D> {
         let stride = grid.stride(0);
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
         let mut local = [0; D];
+        let mut rows = Rows::new(D);
+        let along_offset = |along: usize| s[0] - (start[0] + along) as i64 as f64;
         for _ in 0..self.per_axis.pow(D as u32 - 1) {
             let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
             let first: usize = (1..D)
@@ -395,7 +403,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             });
             let offset = |along: usize| {
                 let mut d = across;
-                d[0] = s[0] - (start[0] + along) as i64 as f64;
+                d[0] = along_offset(along);
                 d
             };
             let within = |along: usize| offset(along).norm_squared() <= radius_squared;
@@ -422,16 +430,26 @@ impl<const D: usize> LocalMaxEnt<D> {
                 grad[selected] = offset(along);
                 selected += 1;
             }
+            if let Some(rows) = &mut rows {
+                rows.push(lo..hi, across[D - 1]);
+            }
             next_block_entry(&mut local[1..], self.per_axis);
         }
-        let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
+        if let Some(rows) = &mut rows {
+            rows.set_columns(along_offset);
+        }
+        let (offsets, weights) = (&grad[..selected], &mut weight[..selected]);
         let cold = SVector::zeros();
         let start_mu = warm.map_or(cold, |solution| solution.predict(&s, self.gamma));
-        let mut solved = self.solve(start_mu, offsets, weights);
+        let nodes = Selected {
+            offsets,
+            rows: rows.as_ref(),
+        };
+        let mut solved = self.solve(start_mu, &nodes, weights);
         if solved.2.is_err() && warm.is_some() {
             // A warm start that falls short (from a multiplier grown large on a face, say)
             // is not yet a failure: the cold start may still converge.
-            solved = self.solve(cold, offsets, weights);
+            solved = self.solve(cold, &nodes, weights);
         }
         let (mu, at, status) = solved;
         // Eq 36 with the offsets taken about their mean r: at r = 0 it is eq 36, and at any
@@ -441,7 +459,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         *warm = inverse
             .filter(|_| status.is_ok())
             .map(|inverse| Solution { s, mu, inverse });
-        for (g, p) in offsets.iter_mut().zip(weights.iter()) {
+        for (g, p) in grad[..selected].iter_mut().zip(weight.iter()) {
             *g = match &inverse {
                 Some(inverse) => -(inverse * (*g - at.r)) * (p * grid.inv_h()),
                 None => SVector::zeros(),
@@ -456,10 +474,10 @@ impl<const D: usize> LocalMaxEnt<D> {
     fn solve(
         &self,
         mut mu: SVector<f64, D>,
-        offsets: &[SVector<f64, D>],
+        nodes: &Selected<D>,
         weight: &mut [f64],
     ) -> (SVector<f64, D>, Moments<D>, Result<usize, LmeFailure>) {
-        let mut at = Moments::at(self.gamma, &mu, offsets, weight);
+        let mut at = Moments::at(self.gamma, &mu, nodes, weight);
         let mut steps = 0;
         loop {
             let residual = at.r.norm();
@@ -474,11 +492,11 @@ impl<const D: usize> LocalMaxEnt<D> {
             };
             let mut step = -cholesky.solve(&at.r);
             step *= (self.max_step / step.norm()).min(1.0);
-            match self.line_search(&mu, &step, &at, offsets, weight) {
+            match self.line_search(&mu, &step, &at, nodes, weight) {
                 Some((next_mu, next)) => (mu, at) = (next_mu, next),
                 None => {
                     // The rejected trials overwrote the weights.
-                    let at = Moments::at(self.gamma, &mu, offsets, weight);
+                    let at = Moments::at(self.gamma, &mu, nodes, weight);
                     return (mu, at, Err(LmeFailure::Stalled { residual }));
                 }
             }
@@ -493,7 +511,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         mu: &SVector<f64, D>,
         step: &SVector<f64, D>,
         at: &Moments<D>,
-        offsets: &[SVector<f64, D>],
+        nodes: &Selected<D>,
         weight: &mut [f64],
     ) -> Option<(SVector<f64, D>, Moments<D>)> {
         let slope = at.r.dot(step);
@@ -502,14 +520,89 @@ impl<const D: usize> LocalMaxEnt<D> {
         for _ in 0..=MAX_HALVINGS {
             let trial_mu = mu + step * alpha;
             // The test needs log Z alone: r and J only for the trial taken.
-            let trial = Exponentials::at(self.gamma, &trial_mu, offsets, weight);
+            let trial = Exponentials::at(self.gamma, &trial_mu, nodes, weight);
             if trial.log_z() <= at.log_z + ARMIJO * alpha * slope + slack {
-                return Some((trial_mu, trial.moments(offsets, weight)));
+                return Some((trial_mu, trial.moments(nodes.offsets, weight)));
             }
             alpha *= 0.5;
         }
         None
     }
+}
+
+/// The selected nodes of a stencil: their scaled offsets d_a, and in 2D their layout by rows.
+struct Selected<'a, const D: usize> {
+    offsets: &'a [SVector<f64, D>],
+    rows: Option<&'a Rows>,
+}
+
+/// The selected nodes in 2D as runs of columns (nodes along the first axis), one run per row
+/// (along the second axis) of the block, in the stencil's order. |d_a|^2 and mu . d_a are
+/// sums over the axes, so exp(f_a) is the product of a column's exponential and a row's:
+/// 2 per_axis calls of exp instead of one per node (about pi r^2).
+struct Rows {
+    /// The offset along the first axis of each column of the block, at `columns`.
+    column: [f64; MAX_SIDE_2D],
+    /// The columns with a selected node in some row.
+    columns: std::ops::Range<usize>,
+    /// Each row's offset along the second axis.
+    row: [f64; MAX_SIDE_2D],
+    /// Each row's selected columns.
+    run: [(u8, u8); MAX_SIDE_2D],
+    /// Rows with a selected node.
+    count: usize,
+}
+
+impl Rows {
+    /// Empty rows in 2D; `None` in 1D, where each node is its own column.
+    fn new(dimension: usize) -> Option<Self> {
+        (dimension == 2).then_some(Rows {
+            column: [0.0; MAX_SIDE_2D],
+            // Empty, and any run pushed widens it to that run.
+            columns: std::ops::Range {
+                start: usize::MAX,
+                end: 0,
+            },
+            row: [0.0; MAX_SIDE_2D],
+            run: [(0, 0); MAX_SIDE_2D],
+            count: 0,
+        })
+    }
+
+    /// Adds a row of the block at offset `across` whose selected columns are `run`, if any.
+    fn push(&mut self, run: std::ops::Range<usize>, across: f64) {
+        if run.is_empty() {
+            return;
+        }
+        self.columns = self.columns.start.min(run.start)..self.columns.end.max(run.end);
+        // A row of a 2D block has at most MAX_SIDE_2D nodes, so the casts are exact.
+        self.run[self.count] = (run.start as u8, run.end as u8);
+        self.row[self.count] = across;
+        self.count += 1;
+    }
+
+    /// Takes the offsets of the columns in use along the first axis.
+    fn set_columns(&mut self, offset: impl Fn(usize) -> f64) {
+        for along in self.columns.clone() {
+            self.column[along] = offset(along);
+        }
+    }
+}
+
+/// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'
+/// offsets d_k; returns the largest.
+fn shifted_exponentials(gamma: f64, mu: f64, offsets: &[f64], out: &mut [f64]) -> f64 {
+    let mut largest = f64::NEG_INFINITY;
+    for (e, &d) in out.iter_mut().zip(offsets) {
+        *e = -gamma * (d * d) + mu * d;
+        if *e > largest {
+            largest = *e;
+        }
+    }
+    for e in out.iter_mut() {
+        *e = (*e - largest).exp();
+    }
+    largest
 }
 
 /// log Z, r and J at one multiplier mu, in scaled units.
@@ -521,18 +614,14 @@ struct Moments<const D: usize> {
 
 impl<const D: usize> Moments<D> {
     /// The moments at `mu`, leaving the weights p_a in `weight`.
-    fn at(
-        gamma: f64,
-        mu: &SVector<f64, D>,
-        offsets: &[SVector<f64, D>],
-        weight: &mut [f64],
-    ) -> Self {
-        Exponentials::at(gamma, mu, offsets, weight).moments(offsets, weight)
+    fn at(gamma: f64, mu: &SVector<f64, D>, nodes: &Selected<D>, weight: &mut [f64]) -> Self {
+        Exponentials::at(gamma, mu, nodes, weight).moments(nodes.offsets, weight)
     }
 }
 
 /// Z at one multiplier mu, as exp(`largest`) `z` with the exponentials exp(f_a - largest) left
-/// in the weights.
+/// in the weights. `largest` is the largest f_a in 1D, and in 2D the sum of the largest column
+/// and row terms (`Rows`), so exp(f_a - largest) <= 1 either way.
 struct Exponentials {
     largest: f64,
     z: f64,
@@ -542,13 +631,22 @@ impl Exponentials {
     fn at<const D: usize>(
         gamma: f64,
         mu: &SVector<f64, D>,
-        offsets: &[SVector<f64, D>],
+        nodes: &Selected<D>,
         weight: &mut [f64],
     ) -> Self {
+        if let Some(rows) = nodes.rows {
+            let by_rows = Self::by_rows(gamma, mu, rows, weight);
+            // Z is 1 or more when the largest column and row meet at a selected node. Where
+            // they meet outside the cut-off radius it is less, and it underflows only for a
+            // huge mu (a point on a face that Newton has not resolved).
+            if by_rows.z > MIN_Z_BY_ROWS {
+                return by_rows;
+            }
+        }
         // Subtracting the largest exponent keeps exp from overflowing and Z >= 1. The exponents
         // are finite, so a comparison does what f64::max does without its NaN handling.
         let mut largest = f64::NEG_INFINITY;
-        for (p, d) in weight.iter_mut().zip(offsets) {
+        for (p, d) in weight.iter_mut().zip(nodes.offsets) {
             *p = -gamma * d.norm_squared() + mu.dot(d);
             if *p > largest {
                 largest = *p;
@@ -562,6 +660,45 @@ impl Exponentials {
         Exponentials { largest, z }
     }
 
+    /// `at` with f_a split into its first axis' term and its second's (`Rows`): each column's
+    /// and each row's exponential, shifted by its largest exponent, is taken once and a node's
+    /// is their product.
+    fn by_rows<const D: usize>(
+        gamma: f64,
+        mu: &SVector<f64, D>,
+        rows: &Rows,
+        weight: &mut [f64],
+    ) -> Self {
+        let columns = rows.columns.clone();
+        let mut column = [0.0; MAX_SIDE_2D];
+        let column_largest = shifted_exponentials(
+            gamma,
+            mu[0],
+            &rows.column[columns.clone()],
+            &mut column[columns],
+        );
+        let mut row = [0.0; MAX_SIDE_2D];
+        let row_largest = shifted_exponentials(
+            gamma,
+            mu[1],
+            &rows.row[..rows.count],
+            &mut row[..rows.count],
+        );
+        let mut z = 0.0;
+        let mut p = weight.iter_mut();
+        for (run, e_row) in rows.run[..rows.count].iter().zip(&row) {
+            // The run first: zip takes from its first iterator first.
+            for (e_column, p) in column[run.0 as usize..run.1 as usize].iter().zip(&mut p) {
+                *p = e_column * e_row;
+                z += *p;
+            }
+        }
+        Exponentials {
+            largest: column_largest + row_largest,
+            z,
+        }
+    }
+
     fn log_z(&self) -> f64 {
         self.largest + self.z.ln()
     }
@@ -573,8 +710,10 @@ impl Exponentials {
         weight: &mut [f64],
     ) -> Moments<D> {
         let mut r = SVector::zeros();
+        // One division per evaluation instead of one per node.
+        let inv_z = 1.0 / self.z;
         for (p, d) in weight.iter_mut().zip(offsets) {
-            *p /= self.z;
+            *p *= inv_z;
             r += d * *p;
         }
         // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation,

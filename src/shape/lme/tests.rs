@@ -444,3 +444,92 @@ fn lme_stencil_entries_are_the_most_nodes_within_the_radius() {
         );
     }
 }
+
+/// The selected nodes of a 2D block of `side` nodes per axis about the scaled position `s`
+/// (block coordinates), as `fill` lists them: row by row, the nodes within `radius`.
+fn selected_by_rows(s: [f64; 2], side: usize, radius: f64) -> (Vec<SVector<f64, 2>>, Rows) {
+    let mut rows = Rows::new(2).unwrap();
+    let mut offsets = Vec::new();
+    for row in 0..side {
+        let across = s[1] - row as f64;
+        let within: Vec<usize> = (0..side)
+            .filter(|&c| (s[0] - c as f64).powi(2) + across * across <= radius * radius)
+            .collect();
+        let run = within
+            .first()
+            .map_or(0..0, |&lo| lo..within.last().unwrap() + 1);
+        offsets.extend(
+            run.clone()
+                .map(|c| SVector::<f64, 2>::new(s[0] - c as f64, across)),
+        );
+        rows.push(run, across);
+    }
+    rows.set_columns(|c| s[0] - c as f64);
+    (offsets, rows)
+}
+
+/// The exponentials taken by rows are those taken node by node to round-off, with the same
+/// log Z; where their sum would underflow (mu huge, the largest row and column meeting far
+/// outside the radius) they are the node-by-node ones, bit for bit.
+#[test]
+fn lme_exponentials_by_rows_match_node_by_node() {
+    let mut rng = Lcg::new(11);
+    for gamma in [0.3, 0.8, 3.0] {
+        let radius = cut_off_radius(gamma, DEFAULT_TOLERANCE);
+        let side = block_side(radius) as usize;
+        for trial in 0..200 {
+            let s = [radius + rng.unit(), radius + rng.unit()];
+            let (offsets, rows) = selected_by_rows(s, side, radius);
+            let scale = if trial % 2 == 0 { 1.0 } else { 20.0 * gamma };
+            let mu = SVector::<f64, 2>::new(
+                scale * (2.0 * rng.unit() - 1.0),
+                scale * (2.0 * rng.unit() - 1.0),
+            );
+            let (mut by_rows, mut by_node) = (vec![0.0; offsets.len()], vec![0.0; offsets.len()]);
+            let with_rows = Selected {
+                offsets: &offsets,
+                rows: Some(&rows),
+            };
+            let without = Selected {
+                offsets: &offsets,
+                rows: None,
+            };
+            let a = Exponentials::at(gamma, &mu, &with_rows, &mut by_rows);
+            let b = Exponentials::at(gamma, &mu, &without, &mut by_node);
+            assert!((a.log_z() - b.log_z()).abs() < 1e-13 * (1.0 + b.log_z().abs()));
+            for (x, y) in by_rows.iter().zip(&by_node) {
+                assert!(
+                    (x / a.z - y / b.z).abs() < 1e-14,
+                    "gamma {gamma}, mu {mu:?}"
+                );
+            }
+        }
+        // The largest column and row meet at the corner, far off the circle, and mu makes the
+        // corner's exponent over 700 above every selected node's: the node-by-node sums are used.
+        let s = [radius, radius];
+        let (offsets, rows) = selected_by_rows(s, side, radius);
+        let mu = SVector::<f64, 2>::new(4000.0 / radius, 4000.0 / radius);
+        let (mut by_rows, mut by_node) = (vec![0.0; offsets.len()], vec![0.0; offsets.len()]);
+        let a = Exponentials::at(
+            gamma,
+            &mu,
+            &Selected {
+                offsets: &offsets,
+                rows: Some(&rows),
+            },
+            &mut by_rows,
+        );
+        let b = Exponentials::at(
+            gamma,
+            &mu,
+            &Selected {
+                offsets: &offsets,
+                rows: None,
+            },
+            &mut by_node,
+        );
+        assert_eq!((a.largest, a.z), (b.largest, b.z));
+        assert_eq!(by_rows, by_node);
+        assert!(b.z >= 1.0);
+    }
+}
