@@ -384,8 +384,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         let stride = grid.stride(0);
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
         let mut local = [0; D];
-        let mut rows = Rows::new(D);
-        let along_offset = |along: usize| s[0] - (start[0] + along) as i64 as f64;
+        let mut rows = Rows::new(&s, &start);
         for _ in 0..self.per_axis.pow(D as u32 - 1) {
             let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
             let first: usize = (1..D)
@@ -403,7 +402,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             });
             let offset = |along: usize| {
                 let mut d = across;
-                d[0] = along_offset(along);
+                d[0] = s[0] - (start[0] + along) as i64 as f64;
                 d
             };
             let within = |along: usize| offset(along).norm_squared() <= radius_squared;
@@ -431,12 +430,9 @@ impl<const D: usize> LocalMaxEnt<D> {
                 selected += 1;
             }
             if let Some(rows) = &mut rows {
-                rows.push(lo..hi, across[D - 1]);
+                rows.push(lo..hi, local[D - 1]);
             }
             next_block_entry(&mut local[1..], self.per_axis);
-        }
-        if let Some(rows) = &mut rows {
-            rows.set_columns(along_offset);
         }
         let (offsets, weights) = (&grad[..selected], &mut weight[..selected]);
         let cold = SVector::zeros();
@@ -541,59 +537,70 @@ struct Selected<'a, const D: usize> {
 /// sums over the axes, so exp(f_a) is the product of a column's exponential and a row's:
 /// 2 per_axis calls of exp instead of one per node (about pi r^2).
 struct Rows {
-    /// The offset along the first axis of each column of the block, at `columns`.
-    column: [f64; MAX_SIDE_2D],
+    /// The point's scaled position and the block's first node, per axis: a column's or a
+    /// row's offset is taken from them as `fill` takes the nodes' offsets.
+    s: [f64; 2],
+    start: [usize; 2],
     /// The columns with a selected node in some row.
     columns: std::ops::Range<usize>,
-    /// Each row's offset along the second axis.
-    row: [f64; MAX_SIDE_2D],
-    /// Each row's selected columns.
+    /// The first row with a selected node; those with one are consecutive (the rows of the
+    /// grid meet the disc of the cut-off radius in a range).
+    first_row: usize,
+    /// Each row's selected columns, from `first_row` on.
     run: [(u8, u8); MAX_SIDE_2D],
     /// Rows with a selected node.
     count: usize,
 }
 
 impl Rows {
-    /// Empty rows in 2D; `None` in 1D, where each node is its own column.
-    fn new(dimension: usize) -> Option<Self> {
-        (dimension == 2).then_some(Rows {
-            column: [0.0; MAX_SIDE_2D],
+    /// No rows yet for the block from `start` about the scaled position `s`, in 2D; `None`
+    /// in 1D, where each node is its own column.
+    fn new<const D: usize>(s: &SVector<f64, D>, start: &[usize; D]) -> Option<Self> {
+        (D == 2).then(|| Rows {
+            s: [s[0], s[D - 1]],
+            start: [start[0], start[D - 1]],
             // Empty, and any run pushed widens it to that run.
             columns: std::ops::Range {
                 start: usize::MAX,
                 end: 0,
             },
-            row: [0.0; MAX_SIDE_2D],
+            first_row: 0,
             run: [(0, 0); MAX_SIDE_2D],
             count: 0,
         })
     }
 
-    /// Adds a row of the block at offset `across` whose selected columns are `run`, if any.
-    fn push(&mut self, run: std::ops::Range<usize>, across: f64) {
+    /// Adds row `row` of the block, whose selected columns are `run`, if any.
+    fn push(&mut self, run: std::ops::Range<usize>, row: usize) {
         if run.is_empty() {
             return;
         }
+        if self.count == 0 {
+            self.first_row = row;
+        }
+        debug_assert_eq!(row, self.first_row + self.count);
         self.columns = self.columns.start.min(run.start)..self.columns.end.max(run.end);
         // A row of a 2D block has at most MAX_SIDE_2D nodes, so the casts are exact.
         self.run[self.count] = (run.start as u8, run.end as u8);
-        self.row[self.count] = across;
         self.count += 1;
     }
 
-    /// Takes the offsets of the columns in use along the first axis.
-    fn set_columns(&mut self, offset: impl Fn(usize) -> f64) {
-        for along in self.columns.clone() {
-            self.column[along] = offset(along);
-        }
+    /// The offset along `axis` of the block's `index`-th node on it.
+    fn offset(&self, axis: usize, index: usize) -> f64 {
+        self.s[axis] - (self.start[axis] + index) as i64 as f64
     }
 }
 
 /// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'
 /// offsets d_k; returns the largest.
-fn shifted_exponentials(gamma: f64, mu: f64, offsets: &[f64], out: &mut [f64]) -> f64 {
+fn shifted_exponentials(
+    gamma: f64,
+    mu: f64,
+    offsets: impl Iterator<Item = f64>,
+    out: &mut [f64],
+) -> f64 {
     let mut largest = f64::NEG_INFINITY;
-    for (e, &d) in out.iter_mut().zip(offsets) {
+    for (e, d) in out.iter_mut().zip(offsets) {
         *e = -gamma * (d * d) + mu * d;
         if *e > largest {
             largest = *e;
@@ -674,24 +681,26 @@ impl Exponentials {
         let column_largest = shifted_exponentials(
             gamma,
             mu[0],
-            &rows.column[columns.clone()],
+            columns.clone().map(|i| rows.offset(0, i)),
             &mut column[columns],
         );
         let mut row = [0.0; MAX_SIDE_2D];
         let row_largest = shifted_exponentials(
             gamma,
             mu[1],
-            &rows.row[..rows.count],
+            (0..rows.count).map(|r| rows.offset(1, rows.first_row + r)),
             &mut row[..rows.count],
         );
         let mut z = 0.0;
-        let mut p = weight.iter_mut();
+        let mut rest = weight;
         for (run, e_row) in rows.run[..rows.count].iter().zip(&row) {
-            // The run first: zip takes from its first iterator first.
-            for (e_column, p) in column[run.0 as usize..run.1 as usize].iter().zip(&mut p) {
+            let run = &column[run.0 as usize..run.1 as usize];
+            let (p, after) = rest.split_at_mut(run.len());
+            for (p, e_column) in p.iter_mut().zip(run) {
                 *p = e_column * e_row;
                 z += *p;
             }
+            rest = after;
         }
         Exponentials {
             largest: column_largest + row_largest,

@@ -448,7 +448,7 @@ fn lme_stencil_entries_are_the_most_nodes_within_the_radius() {
 /// The selected nodes of a 2D block of `side` nodes per axis about the scaled position `s`
 /// (block coordinates), as `fill` lists them: row by row, the nodes within `radius`.
 fn selected_by_rows(s: [f64; 2], side: usize, radius: f64) -> (Vec<SVector<f64, 2>>, Rows) {
-    let mut rows = Rows::new(2).unwrap();
+    let mut rows = Rows::new(&SVector::<f64, 2>::from(s), &[0, 0]).unwrap();
     let mut offsets = Vec::new();
     for row in 0..side {
         let across = s[1] - row as f64;
@@ -462,9 +462,8 @@ fn selected_by_rows(s: [f64; 2], side: usize, radius: f64) -> (Vec<SVector<f64, 
             run.clone()
                 .map(|c| SVector::<f64, 2>::new(s[0] - c as f64, across)),
         );
-        rows.push(run, across);
+        rows.push(run, row);
     }
-    rows.set_columns(|c| s[0] - c as f64);
     (offsets, rows)
 }
 
