@@ -398,18 +398,17 @@ impl<const D: usize> LocalMaxEnt<D> {
                 .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
                 .sum();
             let index = |along: usize| (first + (start[0] + along).min(grid.cells) * stride) as u32;
-            // The offsets d_a along the other axes are the row's; i64's conversion to f64 is
-            // one instruction, usize's several.
+            // The offsets d_a along the other axes are the row's.
             let across = SVector::<f64, D>::from_fn(|k, _| {
                 if k == 0 {
                     0.0
                 } else {
-                    s[k] - (start[k] + local[k]) as i64 as f64
+                    block_offset(s[k], start[k] + local[k])
                 }
             });
             let offset = |along: usize| {
                 let mut d = across;
-                d[0] = s[0] - (start[0] + along) as i64 as f64;
+                d[0] = block_offset(s[0], start[0] + along);
                 d
             };
             let within = |along: usize| offset(along).norm_squared() <= radius_squared;
@@ -551,7 +550,7 @@ struct Selected<'a, const D: usize> {
 /// 2 per_axis calls of exp instead of one per node (about pi r^2).
 struct Rows {
     /// The point's scaled position and the block's first node, per axis: a column's or a
-    /// row's offset is taken from them as `fill` takes the nodes' offsets.
+    /// row's offset is taken from them by `block_offset`, as `fill` takes the nodes'.
     s: [f64; 2],
     start: [usize; 2],
     /// The columns with a selected node in some row.
@@ -600,8 +599,15 @@ impl Rows {
 
     /// The offset along `axis` of the block's `index`-th node on it.
     fn offset(&self, axis: usize, index: usize) -> f64 {
-        self.s[axis] - (self.start[axis] + index) as i64 as f64
+        block_offset(self.s[axis], self.start[axis] + index)
     }
+}
+
+/// The scaled offset s - node of the node numbered `node` along an axis from the scaled
+/// position `s`; i64's conversion to f64 is one instruction, usize's several.
+#[inline]
+fn block_offset(s: f64, node: usize) -> f64 {
+    s - node as i64 as f64
 }
 
 /// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'
@@ -637,9 +643,7 @@ impl<const D: usize> Moments<D> {
     fn at(gamma: f64, mu: &SVector<f64, D>, nodes: &Selected<D>, weight: &mut [f64]) -> Self {
         Exponentials::at(gamma, mu, nodes, weight).moments(nodes.offsets, weight)
     }
-}
 
-impl<const D: usize> Moments<D> {
     /// The moments at mu + `step` from the weights p_a at mu in `weight`, for a step with
     /// |x_a| = |step . d_a| <= SMALL_STEP: p_a exp(x_a) = p_a (1 + x_a + x_a^2 / 2) to
     /// round-off, and Z(mu + step) = Z(mu) sum_a p_a exp(x_a).
@@ -665,7 +669,9 @@ impl<const D: usize> Moments<D> {
 
 /// Z at one multiplier mu, as exp(`largest`) `z` with the exponentials exp(f_a - largest) left
 /// in the weights. `largest` is the largest f_a in 1D, and in 2D the sum of the largest column
-/// and row terms (`Rows`), so exp(f_a - largest) <= 1 either way.
+/// and row terms (`Rows`), so exp(f_a - largest) <= 1 either way; after a small step
+/// (`Moments::after_small_step`) it is log Z at the last multiplier, and the weights are that
+/// multiplier's p_a times exp(step . d_a).
 struct Exponentials {
     largest: f64,
     z: f64,
