@@ -55,7 +55,21 @@ pub fn block_from<const D: usize>(
     per_axis: usize,
 ) -> [usize; D] {
     let last_start = last_start(grid, per_axis);
-    std::array::from_fn(|k| (lo[k].ceil().max(0.0) as usize).min(last_start))
+    std::array::from_fn(|k| ceil_at_least_zero(lo[k]).min(last_start))
+}
+
+/// max(ceil(x), 0) as an index (0 for NaN), through i64: truncation is ceil for x <= 0 and
+/// one below it for a fractional x > 0, without libm's `ceil` (a call on the baseline x86-64
+/// target) or usize's conversion branches.
+#[inline]
+fn ceil_at_least_zero(x: f64) -> usize {
+    let truncated = x as i64;
+    let ceil = if (truncated as f64) < x {
+        truncated.saturating_add(1)
+    } else {
+        truncated
+    };
+    ceil.max(0) as usize
 }
 
 /// Calls `visit(e, index, local)` for the entries `e = 0, 1, ...` of a block of `A` nodes per
@@ -93,5 +107,32 @@ pub fn next_block_entry(local: &mut [usize], per_axis: usize) {
             return;
         }
         *l = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same index as `ceil` and usize's saturating conversion, at integers, just off
+    /// them, negatives, NaN and beyond i64.
+    #[test]
+    fn ceil_at_least_zero_is_ceil_clamped() {
+        let mut xs = vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e300,
+            -1e300,
+            9.3e18,
+        ];
+        for i in -4..6 {
+            let x = i as f64;
+            xs.extend([x, x + 0.5, x.next_up(), x.next_down(), x + 1e-9, x - 1e-9]);
+        }
+        for x in xs {
+            let expected = (x.ceil().max(0.0) as usize).min(1 << 40);
+            assert_eq!(ceil_at_least_zero(x).min(1 << 40), expected, "{x}");
+        }
     }
 }

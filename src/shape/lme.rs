@@ -457,7 +457,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         // Eq 36 with the offsets taken about their mean r: at r = 0 it is eq 36, and at any
         // iterate it is the exact gradient of weights whose first moment misses x by the fixed
         // r, so sum_a grad p_a = 0 and sum_a x_a (x) grad p_a = I hold to round-off.
-        let inverse = at.j.cholesky().map(|c| c.inverse());
+        let inverse = spd_inverse(&at.j);
         *warm = inverse
             .filter(|_| status.is_ok())
             .map(|inverse| Solution { s, mu, inverse });
@@ -489,12 +489,16 @@ impl<const D: usize> LocalMaxEnt<D> {
             if steps == self.max_iterations {
                 return (mu, at, Err(LmeFailure::NotConverged { residual }));
             }
-            let Some(cholesky) = at.j.cholesky() else {
+            let Some(inverse) = spd_inverse(&at.j) else {
                 return (mu, at, Err(LmeFailure::Stalled { residual }));
             };
-            let mut step = -cholesky.solve(&at.r);
-            step *= (self.max_step / step.norm()).min(1.0);
-            if step.norm() * self.radius <= SMALL_STEP {
+            let mut step = -(inverse * at.r);
+            // Compared squared: the square root and division are taken only for a long step.
+            let length_squared = step.norm_squared();
+            if length_squared > self.max_step * self.max_step {
+                step *= self.max_step / length_squared.sqrt();
+            }
+            if step.norm_squared() * (self.radius * self.radius) <= SMALL_STEP * SMALL_STEP {
                 at = at.after_small_step(&step, nodes.offsets, weight);
                 mu += step;
                 steps += 1;
@@ -523,18 +527,42 @@ impl<const D: usize> LocalMaxEnt<D> {
         weight: &mut [f64],
     ) -> Option<(SVector<f64, D>, Moments<D>)> {
         let slope = at.r.dot(step);
-        let slack = ROUNDOFF * (1.0 + at.log_z.abs());
+        let log_z = at.log_z();
+        let slack = ROUNDOFF * (1.0 + log_z.abs());
         let mut alpha = 1.0;
         for _ in 0..=MAX_HALVINGS {
             let trial_mu = mu + step * alpha;
             // The test needs log Z alone: r and J only for the trial taken.
             let trial = Exponentials::at(self.gamma, &trial_mu, nodes, weight);
-            if trial.log_z() <= at.log_z + ARMIJO * alpha * slope + slack {
+            if trial.log_z() <= log_z + ARMIJO * alpha * slope + slack {
                 return Some((trial_mu, trial.moments(nodes.offsets, weight)));
             }
             alpha *= 0.5;
         }
         None
+    }
+}
+
+/// J^-1 of a covariance J, or `None` where J is not positive definite (to round-off). In 1D
+/// and 2D it is the adjugate over the determinant, one division: the Cholesky factor and its
+/// inverse are a chain of square roots and divisions that each Newton step and each gradient
+/// of a point waits on.
+fn spd_inverse<const D: usize>(j: &SMatrix<f64, D, D>) -> Option<SMatrix<f64, D, D>> {
+    match D {
+        1 => (j[0] > 0.0).then(|| SMatrix::from_element(1.0 / j[0])),
+        2 => {
+            let (a, b, c) = (j[(0, 0)], j[(1, 0)], j[(1, 1)]);
+            let det = a * c - b * b;
+            (a > 0.0 && det > 0.0).then(|| {
+                let inv_det = 1.0 / det;
+                SMatrix::from_fn(|k, l| match (k, l) {
+                    (0, 0) => c * inv_det,
+                    (1, 1) => a * inv_det,
+                    _ => -b * inv_det,
+                })
+            })
+        }
+        _ => j.cholesky().map(|c| c.inverse()),
     }
 }
 
@@ -631,14 +659,20 @@ fn shifted_exponentials(
     largest
 }
 
-/// log Z, r and J at one multiplier mu, in scaled units.
+/// Z, r and J at one multiplier mu, in scaled units. log Z is taken when asked for: a
+/// Newton iteration that converges at its first moments or after a small step never needs
+/// the last one's.
 struct Moments<const D: usize> {
-    log_z: f64,
+    z: Exponentials,
     r: SVector<f64, D>,
     j: SMatrix<f64, D, D>,
 }
 
 impl<const D: usize> Moments<D> {
+    fn log_z(&self) -> f64 {
+        self.z.log_z()
+    }
+
     /// The moments at `mu`, leaving the weights p_a in `weight`.
     fn at(gamma: f64, mu: &SVector<f64, D>, nodes: &Selected<D>, weight: &mut [f64]) -> Self {
         Exponentials::at(gamma, mu, nodes, weight).moments(nodes.offsets, weight)
@@ -660,7 +694,7 @@ impl<const D: usize> Moments<D> {
             z += *p;
         }
         Exponentials {
-            largest: self.log_z,
+            largest: self.log_z(),
             z,
         }
         .moments(offsets, weight)
@@ -757,7 +791,7 @@ impl Exponentials {
 
     /// Normalises the exponentials in `weight` to p_a and takes r and J from them.
     fn moments<const D: usize>(
-        &self,
+        self,
         offsets: &[SVector<f64, D>],
         weight: &mut [f64],
     ) -> Moments<D> {
@@ -780,11 +814,7 @@ impl Exponentials {
             }
         }
         j.fill_upper_triangle_with_lower_triangle();
-        Moments {
-            log_z: self.log_z(),
-            r,
-            j,
-        }
+        Moments { z: self, r, j }
     }
 }
 

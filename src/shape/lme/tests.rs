@@ -565,9 +565,47 @@ fn lme_small_step_matches_a_fresh_evaluation() {
                     "gamma {gamma}: {a} vs {b}"
                 );
             }
-            assert!((small.log_z - direct.log_z).abs() < 1e-14 * (1.0 + direct.log_z.abs()));
+            assert!((small.log_z() - direct.log_z()).abs() < 1e-14 * (1.0 + direct.log_z().abs()));
             assert!((small.r - direct.r).norm() < 1e-14 * radius);
             assert!((small.j - direct.j).norm() < 1e-14 * radius * radius);
         }
     }
+}
+
+/// The closed-form inverse of Newton's Hessian is the Cholesky inverse to round-off on
+/// covariances of any conditioning, and refuses the ones that are not positive definite.
+#[test]
+fn lme_closed_form_inverse_matches_cholesky() {
+    let mut rng = Lcg::new(11);
+    for _ in 0..2000 {
+        // Eigenvalues 1 and 10^-8 to 10^2 along a random direction.
+        let (s, c) = (std::f64::consts::PI * rng.unit()).sin_cos();
+        let (l0, l1) = (1.0, 10f64.powf(10.0 * rng.unit() - 8.0));
+        let j = SMatrix::<f64, 2, 2>::new(
+            l0 * c * c + l1 * s * s,
+            (l0 - l1) * c * s,
+            (l0 - l1) * c * s,
+            l0 * s * s + l1 * c * c,
+        );
+        let expected = j.cholesky().unwrap().inverse();
+        let inverse = spd_inverse(&j).unwrap();
+        let condition = l0.max(l1) / l0.min(l1);
+        let tolerance = 8.0 * f64::EPSILON * condition * expected.norm();
+        assert!(
+            (inverse - expected).norm() <= tolerance,
+            "{j} {inverse} {expected}"
+        );
+        let one = SMatrix::<f64, 1, 1>::new(j[(0, 0)]);
+        assert_eq!(spd_inverse(&one).unwrap()[0], 1.0 / j[(0, 0)]);
+    }
+    for j in [
+        SMatrix::<f64, 2, 2>::new(1.0, 1.0, 1.0, 1.0),
+        SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 1.0),
+        SMatrix::<f64, 2, 2>::new(-1.0, 0.0, 0.0, -1.0),
+        SMatrix::<f64, 2, 2>::new(f64::NAN, 0.0, 0.0, 1.0),
+    ] {
+        assert!(spd_inverse(&j).is_none(), "{j}");
+        assert!(j.cholesky().is_none() || j[(0, 0)].is_nan(), "{j}");
+    }
+    assert!(spd_inverse(&SMatrix::<f64, 1, 1>::new(0.0)).is_none());
 }
