@@ -494,11 +494,12 @@ impl<const D: usize> LocalMaxEnt<D> {
             };
             let mut step = -(inverse * at.r);
             // Compared squared: the square root and division are taken only for a long step.
-            let length_squared = step.norm_squared();
+            let mut length_squared = step.norm_squared();
             if length_squared > self.max_step * self.max_step {
                 step *= self.max_step / length_squared.sqrt();
+                length_squared = step.norm_squared();
             }
-            if step.norm_squared() * (self.radius * self.radius) <= SMALL_STEP * SMALL_STEP {
+            if length_squared * (self.radius * self.radius) <= SMALL_STEP * SMALL_STEP {
                 at = at.after_small_step(&step, nodes.offsets, weight);
                 mu += step;
                 steps += 1;
