@@ -6,7 +6,7 @@ use crate::divergence::Divergence;
 use crate::material::{det, Material};
 use crate::parallel;
 use crate::particles::{ParticleChunk, Particles};
-use crate::shape::Stencils;
+use crate::shape::{EntryGradients, NodeGradients, Stencils, VelocityGradient};
 
 /// F_p = (I + dt grad v_p) F_p, J_p = det F_p, V_p = J_p V_p^0 and the stress (from F, or
 /// advanced with grad v for a rate material), after checking that the new state is finite
@@ -42,10 +42,11 @@ pub(super) fn deform_particle<const D: usize>(
     Ok(())
 }
 
-/// grad v_p = sum_i v_i (x) grad N_ip from the nodal velocity `velocity`, then F, J and the
-/// stress of every particle: MUSL's eqs 37-40 of Tran et al. with v_i^L (eq 37 prints N), and
-/// the predictor-corrector's steps 4-5 with v~_i. Chunks of particles run in parallel
-/// (`parallel::map_chunks`); the error is that of the first particle that failed.
+/// grad v_p = sum_i v_i (x) grad N_ip from the nodal velocity `velocity` (in factored form for
+/// the dual-domain basis), then F, J and the stress of every particle: MUSL's eqs 37-40 of
+/// Tran et al. with v_i^L (eq 37 prints N), and the predictor-corrector's steps 4-5 with
+/// v~_i. Chunks of particles run in parallel (`parallel::map_chunks`); the error is that of
+/// the first particle that failed.
 pub fn deform_particles<const D: usize>(
     stencils: &Stencils<D>,
     particles: &mut Particles<D>,
@@ -53,11 +54,27 @@ pub fn deform_particles<const D: usize>(
     dt: f64,
     material: &Material,
 ) -> Result<(), Divergence> {
+    match stencils.dual_domain() {
+        Some(dual) => {
+            let gradients = NodeGradients(dual.velocity_gradients(velocity));
+            deform_with(stencils, particles, &gradients, dt, material)
+        }
+        None => deform_with(stencils, particles, &EntryGradients(velocity), dt, material),
+    }
+}
+
+fn deform_with<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &mut Particles<D>,
+    gradients: &impl VelocityGradient<D>,
+    dt: f64,
+    material: &Material,
+) -> Result<(), Divergence> {
     let deform = |mut chunk: ParticleChunk<D>| {
         for q in 0..chunk.f.len() {
             let grad_v: SMatrix<f64, D, D> = stencils
                 .of(chunk.start + q)
-                .map(|(i, _, g)| velocity[i] * g.transpose())
+                .map(|(i, w, g)| gradients.term(i, w, g))
                 .sum();
             deform_particle(&mut chunk, q, &grad_v, dt, true, material)?;
         }

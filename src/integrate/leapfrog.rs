@@ -12,7 +12,7 @@ use crate::grid::GridState;
 use crate::material::Material;
 use crate::parallel;
 use crate::particles::{ParticleChunk, Particles};
-use crate::shape::Stencils;
+use crate::shape::{EntryGradients, NodeGradients, Stencils, VelocityGradient};
 
 /// Step 3 of Gong sec 4.4, one pass per particle with N and grad N taken at x_p^s:
 /// v_p += kick sum_i N_ip a_i, x_p += dt sum_i N_ip v_i^{s+1/2},
@@ -33,20 +33,53 @@ pub fn update_particles<const D: usize>(
     dt: f64,
     material: &Material,
 ) -> Result<(), Divergence> {
+    let step = Step {
+        grid,
+        drift,
+        kick,
+        dt,
+    };
+    match stencils.dual_domain() {
+        Some(dual) => {
+            let gradients = NodeGradients(dual.velocity_gradients(&grid.velocity_new));
+            update_with(stencils, particles, &step, &gradients, material)
+        }
+        None => {
+            let gradients = EntryGradients(&grid.velocity_new);
+            update_with(stencils, particles, &step, &gradients, material)
+        }
+    }
+}
+
+/// The nodal fields and step lengths of `update_particles`.
+struct Step<'a, const D: usize> {
+    grid: &'a GridState<D>,
+    drift: &'a [SVector<f64, D>],
+    kick: f64,
+    dt: f64,
+}
+
+fn update_with<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &mut Particles<D>,
+    step: &Step<D>,
+    gradients: &impl VelocityGradient<D>,
+    material: &Material,
+) -> Result<(), Divergence> {
     let update = |mut chunk: ParticleChunk<D>| {
         for q in 0..chunk.x.len() {
             let mut a = SVector::<f64, D>::zeros();
             let mut v = SVector::<f64, D>::zeros();
             let mut grad_v = SMatrix::<f64, D, D>::zeros();
             for (i, w, g) in stencils.of(chunk.start + q) {
-                a += grid.force[i] * w;
-                v += drift[i] * w;
-                grad_v += grid.velocity_new[i] * g.transpose();
+                a += step.grid.force[i] * w;
+                v += step.drift[i] * w;
+                grad_v += gradients.term(i, w, g);
             }
-            chunk.v[q] += a * kick;
-            chunk.x[q] += v * dt;
+            chunk.v[q] += a * step.kick;
+            chunk.x[q] += v * step.dt;
             let finite = a.iter().all(|c| c.is_finite());
-            deform_particle(&mut chunk, q, &grad_v, dt, finite, material)?;
+            deform_particle(&mut chunk, q, &grad_v, step.dt, finite, material)?;
         }
         Ok(())
     };

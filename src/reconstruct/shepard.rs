@@ -1,4 +1,4 @@
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use crate::grid::GridState;
 use crate::parallel;
@@ -30,8 +30,9 @@ pub fn particle_sums<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
-    if stencils.has_value_entries() {
-        // Mass and momentum over the entries with values, the forces over all of them.
+    if stencils.has_value_entries() || stencils.dual_domain().is_some() {
+        // Mass and momentum over the entries with values, the forces over all of them (or in
+        // factored form).
         lumped_sums(stencils, &particles.mass, &particles.v, grid);
         nodal_forces(stencils, particles, body_force, &mut grid.force);
         return;
@@ -99,7 +100,10 @@ fn lumped_sums<const D: usize>(
 }
 
 /// The forces of `particles_to_grid` alone, into `force`: f_i = sum_p (M_p b_p N_ip -
-/// V_p sigma_p grad N_ip), for integrators that update the stress after the mapping.
+/// V_p sigma_p grad N_ip), for integrators that update the stress after the mapping. For the
+/// dual-domain basis the internal force is taken in factored form: T_j = sum_p N_jp V_p
+/// sigma_p over the hat's entries, then f_i -= sum_j T_j A_ij
+/// (`DualDomain::subtract_divergence`).
 pub fn nodal_forces<const D: usize>(
     stencils: &Stencils<D>,
     particles: &Particles<D>,
@@ -112,6 +116,21 @@ pub fn nodal_forces<const D: usize>(
         let vs = particles.stress[p] * particles.volume(p);
         (vs, body_force[p] * particles.mass[p])
     };
+    if let Some(dual) = stencils.dual_domain() {
+        let mut stress = vec![SMatrix::<f64, D, D>::zeros(); force.len()];
+        stencils.scatter(
+            particles.len(),
+            len,
+            force.chunks_mut(len).zip(stress.chunks_mut(len)),
+            point,
+            |(force, stress), i, (vs, mb), w, _| {
+                force[i] += mb * w;
+                stress[i] += vs * w;
+            },
+        );
+        dual.subtract_divergence(&stress, force);
+        return;
+    }
     stencils.scatter(
         particles.len(),
         len,
@@ -172,7 +191,6 @@ mod tests {
     use crate::benchmarks::{gong_mms, thesis_params, Problem, SineMms};
     use crate::grid::Grid;
     use crate::shape::{LinearHat, Shape};
-    use nalgebra::SMatrix;
 
     fn problem<const D: usize>() -> SineMms<D> {
         gong_mms(&thesis_params(0.1, 6, 3)).unwrap()

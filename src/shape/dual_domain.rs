@@ -5,17 +5,15 @@
 //! with both integrals over the material: sums over the particles (as Zhang et al. and
 //! Wobbes et al. define it) or exact integrals over the cells that hold particles.
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use super::block::{block_around_cell, for_each_block_node, NODES_PER_AXIS};
-use super::{LinearHat, Shape};
+use super::{Shape, Stencils};
 use crate::grid::{lattice_coords, Dofs, Grid};
+use crate::parallel;
 
 /// Offsets i - j per axis of the nodes i whose hat overlaps that of node j: -1, 0, 1.
 const NEIGHBOURS_PER_AXIS: usize = 3;
-
-/// Hat corners of a cell in at most two dimensions.
-const MAX_CORNERS: usize = 4;
 
 /// Block places (first axis fastest) per axis in at most two dimensions.
 const BLOCK_PLACE: [usize; 2] = [1, NODES_PER_AXIS];
@@ -48,13 +46,13 @@ const fn neighbour_steps<const D: usize>() -> [usize; 9] {
 }
 
 /// Bit n set for each offset o in {0, 1, 2}^D (n = o in base 3, first axis fastest) that
-/// takes the block node at `local` to block node `local + o - 1`.
-fn neighbours_in_block<const D: usize>(local: &[usize; D]) -> u32 {
+/// takes the node at `local` to node `local + o - 1` of a lattice of `len` nodes per axis.
+fn neighbours_within<const D: usize>(local: &[usize; D], len: usize) -> u32 {
     let (mut reached, mut width) = (1, 1);
     for &l in local {
         let mut next = 0;
         for o in 0..NEIGHBOURS_PER_AXIS {
-            if (1..=NODES_PER_AXIS).contains(&(l + o)) {
+            if (1..=len).contains(&(l + o)) {
                 next |= reached << (o * width);
             }
         }
@@ -85,6 +83,10 @@ pub enum DualIntegrals {
 /// the boxes open gaps (docs/NOTES.md).
 pub struct DualDomain<const D: usize> {
     integrals: DualIntegrals,
+    grid: Grid<D>,
+    /// Per offset o in {0, 1, 2}^D (first axis fastest), the grid index of node n + o - 1
+    /// counted from that of n - 1 (every axis).
+    grid_steps: [usize; 9],
     /// Per cell, whether a particle is in it.
     active: Vec<bool>,
     /// int S_j per node j.
@@ -102,6 +104,11 @@ impl<const D: usize> DualDomain<D> {
         let n = grid.num_nodes();
         DualDomain {
             integrals,
+            grid: grid.clone(),
+            grid_steps: std::array::from_fn(|o| {
+                let digits = lattice_coords(o, &[NEIGHBOURS_PER_AXIS; D]);
+                (0..D).map(|k| digits[k] * grid.stride(k)).sum()
+            }),
             active: vec![false; grid.cells.pow(D as u32)],
             volume: vec![0.0; n],
             average: vec![SVector::zeros(); n * Self::neighbours()],
@@ -112,22 +119,16 @@ impl<const D: usize> DualDomain<D> {
         NEIGHBOURS_PER_AXIS.pow(D as u32)
     }
 
-    /// The integrals over this step's material: the particles at `positions` with the
-    /// volumes `volumes`, each inside the cell listed in `cells` (flat indices,
+    /// The integrals over this step's material: the particles of the hat stencils `hat`
+    /// with the volumes `volumes`, each inside the cell listed in `cells` (flat indices,
     /// `Grid::cell_index`). Sums run particle by particle, or cell by cell in index order: a
     /// fixed summation order either way.
-    pub fn integrate(
-        &mut self,
-        grid: &Grid<D>,
-        positions: &[SVector<f64, D>],
-        volumes: &[f64],
-        cells: &[usize],
-    ) {
+    pub fn integrate(&mut self, hat: &Stencils<D>, volumes: &[f64], cells: &[usize]) {
         self.volume.fill(0.0);
         self.average.fill(SVector::zeros());
         match self.integrals {
-            DualIntegrals::Particles => self.sum_particles(grid, positions, volumes),
-            DualIntegrals::ActiveCells => self.integrate_cells(grid, cells),
+            DualIntegrals::Particles => self.sum_particles(hat, volumes),
+            DualIntegrals::ActiveCells => self.integrate_cells(cells),
         }
         let stride = Self::neighbours();
         for (j, &volume) in self.volume.iter().enumerate() {
@@ -138,22 +139,18 @@ impl<const D: usize> DualDomain<D> {
         }
     }
 
-    /// int S_j ~ sum_p N_j(x_p) V_p and int grad S_i S_j ~ sum_p grad N_i(x_p) N_j(x_p) V_p.
-    fn sum_particles(&mut self, grid: &Grid<D>, positions: &[SVector<f64, D>], volumes: &[f64]) {
+    /// int S_j ~ sum_p N_j(x_p) V_p and int grad S_i S_j ~ sum_p grad N_i(x_p) N_j(x_p) V_p,
+    /// with the hat's entries of every particle (corner order, as `LinearHat` lists them).
+    fn sum_particles(&mut self, hat: &Stencils<D>, volumes: &[f64]) {
         let corners = 1 << D;
+        debug_assert_eq!(hat.per_point, corners);
         let stride = Self::neighbours();
-        let mut node = [0u32; MAX_CORNERS];
-        let mut weight = [0.0; MAX_CORNERS];
-        let mut grad = [SVector::<f64, D>::zeros(); MAX_CORNERS];
-        for (x, &v) in positions.iter().zip(volumes) {
-            let (node, weight, grad) = (
-                &mut node[..corners],
-                &mut weight[..corners],
-                &mut grad[..corners],
-            );
-            // The solver has located every particle inside the grid.
-            let inside = LinearHat.eval(grid, x, node, weight, grad);
-            debug_assert!(inside);
+        let entries = hat
+            .node
+            .chunks_exact(corners)
+            .zip(hat.weight.chunks_exact(corners))
+            .zip(hat.grad.chunks_exact(corners));
+        for (((node, weight), grad), &v) in entries.zip(volumes) {
             for b in 0..corners {
                 let j = node[b] as usize;
                 let share = weight[b] * v;
@@ -166,8 +163,68 @@ impl<const D: usize> DualDomain<D> {
         }
     }
 
+    /// Per node j, G_j = sum_i v_i (x) A_ij with A_ij = (int grad S_i S_j) / (int S_j), the
+    /// node's average of the velocity gradient for the nodal velocity `velocity`: the modified
+    /// velocity gradient at a point x is sum_j S_j(x) G_j, which is sum_i v_i (x)
+    /// grad S~_i(x) with the sums taken the other way round. Nodes without material get
+    /// zero.
+    pub fn velocity_gradients(&self, velocity: &[SVector<f64, D>]) -> Vec<SMatrix<f64, D, D>> {
+        let mut out = vec![SMatrix::zeros(); velocity.len()];
+        let len = parallel::block_len(out.len());
+        let fill = |(b, out): (usize, &mut [SMatrix<f64, D, D>])| {
+            for (m, g) in out.iter_mut().enumerate() {
+                let j = b * len + m;
+                if self.volume[j] > 0.0 {
+                    self.for_each_neighbour(j, |o, i| {
+                        *g += velocity[i] * self.average[j * Self::neighbours() + o].transpose();
+                    });
+                }
+            }
+        };
+        parallel::map_chunks(out.chunks_mut(len).enumerate(), fill);
+        out
+    }
+
+    /// f_i -= sum_j T_j A_ij over the nodes j whose hats overlap that of i, for nodal tensors
+    /// T_j = sum_p S_j(x_p) V_p sigma_p (`stress`): the internal force sum_p V_p sigma_p
+    /// grad S~_i(x_p) with the sums taken the other way round.
+    pub fn subtract_divergence(
+        &self,
+        stress: &[SMatrix<f64, D, D>],
+        force: &mut [SVector<f64, D>],
+    ) {
+        let len = parallel::block_len(force.len());
+        // Node j = i + 1 - d is reached from i by the offset o = 2 - d, so that i is j's
+        // neighbour d = (3^D - 1) - o.
+        let last = Self::neighbours() - 1;
+        let subtract = |(b, force): (usize, &mut [SVector<f64, D>])| {
+            for (m, f) in force.iter_mut().enumerate() {
+                let i = b * len + m;
+                self.for_each_neighbour(i, |o, j| {
+                    *f -= stress[j] * self.average[j * Self::neighbours() + last - o];
+                });
+            }
+        };
+        parallel::map_chunks(force.chunks_mut(len).enumerate(), subtract);
+    }
+
+    /// `visit(o, m)` for each offset o in {0, 1, 2}^D (in base 3, first axis fastest, in
+    /// increasing order) that takes node `n` to a node m = n + o - 1 of the grid.
+    #[inline]
+    fn for_each_neighbour(&self, n: usize, mut visit: impl FnMut(usize, usize)) {
+        let coords = self.grid.node_coords(n);
+        let reached = neighbours_within(&coords, self.grid.nodes_per_dim());
+        let first = (0..D).fold(n, |m, k| m.wrapping_sub(self.grid.stride(k)));
+        for (o, step) in self.grid_steps[..Self::neighbours()].iter().enumerate() {
+            if reached >> o & 1 == 1 {
+                visit(o, first.wrapping_add(*step));
+            }
+        }
+    }
+
     /// The exact integrals over the active cells among `cells`.
-    fn integrate_cells(&mut self, grid: &Grid<D>, cells: &[usize]) {
+    fn integrate_cells(&mut self, cells: &[usize]) {
+        let grid = &self.grid;
         self.active.fill(false);
         for &c in cells {
             self.active[c] = true;
@@ -305,7 +362,7 @@ impl<const D: usize> Shape<D> for DualDomain<D> {
                 let local: [usize; D] = std::array::from_fn(|k| cell[k] + upper[k] - start[k]);
                 let entry = block_entry::<D>(&local);
                 weight[entry] = hat;
-                let reached = neighbours_in_block(&local);
+                let reached = neighbours_within(&local, NODES_PER_AXIS);
                 let first = entry.wrapping_sub(const { block_entry::<D>(&[1; D]) });
                 for (n, (average, step)) in averages.enumerate() {
                     if reached >> n & 1 == 1 {
@@ -328,7 +385,7 @@ mod tests {
     use super::*;
     use crate::grid::{lattice_coords, Domain};
     use crate::rng::Lcg;
-    use crate::shape::Stencils;
+    use crate::shape::LinearHat;
 
     fn grid<const D: usize>(cells: usize) -> Grid<D> {
         Grid::new(&Domain {
@@ -346,7 +403,9 @@ mod tests {
         volumes: &[f64],
     ) -> DualDomain<D> {
         let mut dual = DualDomain::new(g, integrals);
-        dual.integrate(g, positions, volumes, &cells_of(g, positions));
+        let mut hat = Stencils::new(Shape::<D>::nodes_per_point(&LinearHat), positions.len());
+        hat.update(&LinearHat, g, positions).unwrap();
+        dual.integrate(&hat, volumes, &cells_of(g, positions));
         dual
     }
 
@@ -373,6 +432,32 @@ mod tests {
             .collect()
     }
 
+    /// `n` particles at random in [0, 0.6]^D (the cells beyond 2/3 empty), every `face`-th
+    /// of them moved onto the grid's upper face x_0 = 1, and their random volumes.
+    fn scattered<const D: usize>(
+        rng: &mut Lcg,
+        n: usize,
+        face: Option<usize>,
+    ) -> (Vec<SVector<f64, D>>, Vec<f64>) {
+        let positions: Vec<SVector<f64, D>> = (0..n)
+            .map(|p| {
+                let on_face = face.is_some_and(|every| p % every == 0);
+                SVector::from_fn(|k, _| {
+                    if on_face && k == 0 {
+                        1.0
+                    } else {
+                        0.6 * rng.unit()
+                    }
+                })
+            })
+            .collect();
+        let volumes = positions
+            .iter()
+            .map(|_| 1e-3 * (0.5 + rng.unit()))
+            .collect();
+        (positions, volumes)
+    }
+
     /// Random particles with random volumes in [0, 0.6]^D (the cells beyond 2/3 empty) and
     /// random points, for both integrals. Where every corner of the point's cell has material,
     /// sum_i grad S~_i = 0 and sum_i x_i (x) grad S~_i = I; where some has none, the second is
@@ -380,13 +465,7 @@ mod tests {
     fn check_consistency<const D: usize>(integrals: DualIntegrals) {
         let g = grid::<D>(6);
         let mut rng = Lcg::new(2011);
-        let positions: Vec<SVector<f64, D>> = (0..300 * D)
-            .map(|_| SVector::from_fn(|_, _| 0.6 * rng.unit()))
-            .collect();
-        let volumes: Vec<f64> = positions
-            .iter()
-            .map(|_| 1e-3 * (0.5 + rng.unit()))
-            .collect();
+        let (positions, volumes) = scattered::<D>(&mut rng, 300 * D, None);
         let dual = integrated(&g, integrals, &positions, &volumes);
         let (mut filled, mut partial) = (0, 0);
         let points = (0..500).map(|_| SVector::from_fn(|_, _| rng.unit()));
@@ -480,6 +559,81 @@ mod tests {
     #[test]
     fn value_entries_are_the_nonzero_values_2d() {
         check_value_entries::<2>();
+    }
+
+    /// The factored gradients are the explicit ones with the sums taken the other way round:
+    /// for scattered particles with random volumes (cells beyond 2/3 empty, points on the
+    /// grid's upper faces), random nodal velocities and particle stresses, sum_j N_jp G_j
+    /// equals sum_i v_i (x) grad S~_i(x_p) at every particle, -sum_j T_j A_ij equals
+    /// -sum_p V_p sigma_p grad S~_i(x_p) at every node, both to round-off, and the internal
+    /// forces sum to zero.
+    fn check_factored<const D: usize>() {
+        for integrals in [DualIntegrals::Particles, DualIntegrals::ActiveCells] {
+            check_factored_with::<D>(integrals);
+        }
+    }
+
+    fn check_factored_with<const D: usize>(integrals: DualIntegrals) {
+        let g = grid::<D>(6);
+        let mut rng = Lcg::new(2012);
+        let (positions, volumes) = scattered::<D>(&mut rng, 300 * D, Some(10));
+        let dual = integrated(&g, integrals, &positions, &volumes);
+        let mut explicit = Stencils::new(dual.nodes_per_point(), positions.len());
+        explicit.update(&dual, &g, &positions).unwrap();
+        let mut hat = Stencils::new(Shape::<D>::nodes_per_point(&LinearHat), positions.len());
+        hat.update(&LinearHat, &g, &positions).unwrap();
+        let velocity: Vec<SVector<f64, D>> = (0..g.num_nodes())
+            .map(|_| SVector::from_fn(|_, _| rng.unit() - 0.5))
+            .collect();
+        let stress: Vec<SMatrix<f64, D, D>> = positions
+            .iter()
+            .map(|_| SMatrix::from_fn(|_, _| 1e3 * (rng.unit() - 0.5)))
+            .collect();
+
+        let nodal = dual.velocity_gradients(&velocity);
+        for p in 0..positions.len() {
+            let direct: SMatrix<f64, D, D> = explicit
+                .of(p)
+                .map(|(i, _, gr)| velocity[i] * gr.transpose())
+                .sum();
+            let factored: SMatrix<f64, D, D> = hat.of(p).map(|(j, w, _)| nodal[j] * w).sum();
+            let scale = explicit.of(p).map(|(_, _, gr)| gr.norm()).sum::<f64>();
+            assert!(
+                (direct - factored).norm() <= 1e-14 * scale,
+                "{p}: {direct:?} vs {factored:?}"
+            );
+        }
+
+        let mut direct = vec![SVector::<f64, D>::zeros(); g.num_nodes()];
+        let mut sums = vec![SMatrix::<f64, D, D>::zeros(); g.num_nodes()];
+        let mut scale = 0.0;
+        for p in 0..positions.len() {
+            let vs = stress[p] * volumes[p];
+            for (i, _, gr) in explicit.of(p) {
+                direct[i] -= vs * gr;
+                scale += (vs * gr).norm();
+            }
+            for (j, w, _) in hat.of(p) {
+                sums[j] += vs * w;
+            }
+        }
+        let mut factored = vec![SVector::<f64, D>::zeros(); g.num_nodes()];
+        dual.subtract_divergence(&sums, &mut factored);
+        for (i, (a, b)) in direct.iter().zip(&factored).enumerate() {
+            assert!((a - b).norm() <= 1e-14 * scale, "node {i}: {a:?} vs {b:?}");
+        }
+        let total: SVector<f64, D> = factored.iter().sum();
+        assert!(total.norm() <= 1e-14 * scale, "sum of forces {total:?}");
+    }
+
+    #[test]
+    fn factored_gradients_equal_the_explicit_ones_1d() {
+        check_factored::<1>();
+    }
+
+    #[test]
+    fn factored_gradients_equal_the_explicit_ones_2d() {
+        check_factored::<2>();
     }
 
     /// `ppc` particles per cell and axis at the centres of equal sub-cells (the seeding), each

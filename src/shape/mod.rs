@@ -22,7 +22,7 @@ pub use lme::{
     LmeFailure, LmeParamError, LocalMaxEnt, DEFAULT_TOLERANCE, MAX_ITERATIONS, MAX_STENCIL_NODES,
     RESIDUAL_TOLERANCE,
 };
-pub use stencils::Stencils;
+pub use stencils::{EntryGradients, NodeGradients, Stencils, VelocityGradient};
 
 /// A family of grid basis functions N_i(x).
 pub trait Shape<const D: usize>: Sync {

@@ -1,11 +1,38 @@
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use crate::fallible::filled;
 use crate::parallel;
 
-use super::Shape;
+use super::{DualDomain, LinearHat, Shape};
 
 use crate::grid::Grid;
+
+/// The velocity gradient at a particle, sum_i v_i (x) grad N_ip, one stencil entry at a time.
+pub trait VelocityGradient<const D: usize>: Sync {
+    /// The term of entry (node i, N_ip, grad N_ip).
+    fn term(&self, i: usize, w: f64, g: &SVector<f64, D>) -> SMatrix<f64, D, D>;
+}
+
+/// The sum over the entries' gradients, v_i (x) grad N_ip, for the nodal velocity v_i.
+pub struct EntryGradients<'a, const D: usize>(pub &'a [SVector<f64, D>]);
+
+impl<const D: usize> VelocityGradient<D> for EntryGradients<'_, D> {
+    #[inline(always)]
+    fn term(&self, i: usize, _: f64, g: &SVector<f64, D>) -> SMatrix<f64, D, D> {
+        self.0[i] * g.transpose()
+    }
+}
+
+/// The sum in factored form, N_jp G_j, from the nodal averages G_j of the velocity gradient
+/// (`DualDomain::velocity_gradients`).
+pub struct NodeGradients<const D: usize>(pub Vec<SMatrix<f64, D, D>>);
+
+impl<const D: usize> VelocityGradient<D> for NodeGradients<D> {
+    #[inline(always)]
+    fn term(&self, j: usize, w: f64, _: &SVector<f64, D>) -> SMatrix<f64, D, D> {
+        self.0[j] * w
+    }
+}
 
 /// Shape-function values of every particle, `per_point` entries each, stored flat so
 /// that the transfer loops walk memory in order and nothing is allocated per step.
@@ -17,6 +44,10 @@ pub struct Stencils<const D: usize> {
     /// For a basis whose values reach fewer nodes than its gradients, each point's entries
     /// with nonzero values in stencil order, padded with zero values (gradients unused).
     values: Option<Box<Stencils<D>>>,
+    /// The dual-domain basis at the particles: the entries are the hat's, and the gradients
+    /// are taken from the nodal averages in factored form (`DualDomain::velocity_gradients`,
+    /// `DualDomain::subtract_divergence`), 2^D entries per particle instead of 4^D.
+    dual: Option<Box<DualDomain<D>>>,
 }
 
 impl<const D: usize> Stencils<D> {
@@ -28,7 +59,42 @@ impl<const D: usize> Stencils<D> {
             weight: filled(n, 0.0, "the stencils' values"),
             grad: filled(n, SVector::zeros(), "the stencils' gradients"),
             values: None,
+            dual: None,
         }
+    }
+
+    /// Makes these the particles' stencils of the dual-domain basis with the integrals of
+    /// `dual` (`update_dual_domain`).
+    pub fn attach_dual_domain(&mut self, dual: DualDomain<D>) {
+        let corners = Shape::<D>::nodes_per_point(&LinearHat);
+        if self.per_point != corners {
+            self.reshape(corners);
+        }
+        self.dual = Some(Box::new(dual));
+    }
+
+    /// The dual-domain integrals whose averages give these stencils' gradients, if any.
+    pub fn dual_domain(&self) -> Option<&DualDomain<D>> {
+        self.dual.as_deref()
+    }
+
+    /// The hat's entries at `positions`, then the attached dual-domain integrals over the
+    /// particles with the volumes `volumes` in the cells `cells`, which are returned. Fails
+    /// as `update` does.
+    pub fn update_dual_domain(
+        &mut self,
+        grid: &Grid<D>,
+        positions: &[SVector<f64, D>],
+        volumes: &[f64],
+        cells: &[usize],
+    ) -> Result<&DualDomain<D>, usize> {
+        self.update(&LinearHat, grid, positions)?;
+        let mut dual = self
+            .dual
+            .take()
+            .expect("`attach_dual_domain` comes before the updates");
+        dual.integrate(self, volumes, cells);
+        Ok(self.dual.insert(dual))
     }
 
     /// The entries to sum values over (mass, momentum, N-weighted gathers): each point's

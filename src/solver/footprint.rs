@@ -12,7 +12,7 @@ use crate::benchmarks::{AnyProblem, Problem};
 use crate::grid::Grid;
 use crate::methods::Method;
 use crate::reconstruct::{MassMatrix, NodalVelocity, Recipe, TransferKind};
-use crate::shape::{DualDomain, LinearHat, LocalMaxEnt, ParticleDomains, Shape, ShapeKind};
+use crate::shape::{LinearHat, LocalMaxEnt, ParticleDomains, Shape, ShapeKind};
 
 /// The HDF5 library, its chunk caches, and the stream's chunk buffers (about 1 MiB per
 /// growing dataset).
@@ -89,16 +89,22 @@ fn simulation_bytes<const D: usize>(
             mass + stencil_bytes(points) + 256.0 * points + 1024.0 * cells.powi(D as i32)
         }
     };
-    particles * (state + sample) + stencil_bytes(particles) + nodes * per_node + transfer
+    // The dual-domain integrals (int S_j and 3^D averages per node) and the nodal tensors
+    // of its factored gradients.
+    let dual = match method.shape {
+        ShapeKind::DualDomain(_) => 8.0 * (3f64.powi(D as i32) * d + 1.0 + 2.0 * d * d),
+        _ => 0.0,
+    };
+    particles * (state + sample) + stencil_bytes(particles) + nodes * (per_node + dual) + transfer
 }
 
 /// The nodes each particle's stencil holds for the method's basis.
 pub fn stencil_nodes<const D: usize>(shape: ShapeKind) -> usize {
     match shape {
-        ShapeKind::Linear => Shape::<D>::nodes_per_point(&LinearHat),
+        // The dual-domain basis holds the hat's entries; its gradients are nodal averages.
+        ShapeKind::Linear | ShapeKind::DualDomain(_) => Shape::<D>::nodes_per_point(&LinearHat),
         ShapeKind::Domain(_) => ParticleDomains::<D>::nodes_per_point(),
         ShapeKind::BSpline(degree) => degree.shape::<D>().nodes_per_point(),
-        ShapeKind::DualDomain(_) => DualDomain::<D>::stencil_nodes(),
         ShapeKind::LocalMaxEnt(settings) => {
             LocalMaxEnt::<D>::with_tolerance(settings.gamma, settings.tolerance)
                 .map_or(1, |lme| lme.nodes_per_point())

@@ -110,8 +110,9 @@ enum Basis<const D: usize> {
     Domains(ParticleDomains<D>),
     /// The B-spline of a degree evaluated at x_p.
     BSpline(SplineDegree),
-    /// The hat with the dual-domain gradient, from the integrals over this step's material.
-    DualDomain(DualDomain<D>),
+    /// The hat with the dual-domain gradient, from the integrals over this step's material,
+    /// which the stencils hold (`Stencils::attach_dual_domain`).
+    DualDomain,
     /// Local maximum-entropy functions evaluated at x_p.
     LocalMaxEnt(LocalMaxEnt<D>),
 }
@@ -128,11 +129,13 @@ enum Mapping {
 impl<const D: usize> Basis<D> {
     /// The basis as a function of position on the grid, for transfers that evaluate it at
     /// points of their own. Particle domains have none; their grid basis is the hat.
-    fn shape(&self) -> &dyn Shape<D> {
+    fn shape<'a>(&'a self, stencils: &'a Stencils<D>) -> &'a dyn Shape<D> {
         match self {
             Basis::Hat | Basis::Domains(_) => &LinearHat,
             Basis::BSpline(degree) => degree.shape(),
-            Basis::DualDomain(dual) => dual,
+            Basis::DualDomain => stencils
+                .dual_domain()
+                .expect("the dual-domain integrals are attached with the basis"),
             Basis::LocalMaxEnt(lme) => lme,
         }
     }
@@ -189,12 +192,18 @@ impl<'a, const D: usize> Run<'a, D> {
         }
         let n = particles.len();
         let particle_mass = particles.mass.iter().cloned().fold(0.0, f64::max);
+        let per_point = match method.shape {
+            ShapeKind::Domain(_) => ParticleDomains::<D>::narrow_nodes_per_point(),
+            shape => footprint::stencil_nodes::<D>(shape),
+        };
+        let mut stencils = Stencils::new(per_point, n);
         let basis = match method.shape {
             ShapeKind::Linear => Basis::Hat,
             ShapeKind::Domain(shape) => Basis::Domains(ParticleDomains::new(shape, &particles)),
             ShapeKind::BSpline(degree) => Basis::BSpline(degree),
             ShapeKind::DualDomain(integrals) => {
-                Basis::DualDomain(DualDomain::new(&grid, integrals))
+                stencils.attach_dual_domain(DualDomain::new(&grid, integrals));
+                Basis::DualDomain
             }
             ShapeKind::LocalMaxEnt(settings) => {
                 // `methods::resolve` has checked gamma and the cut-off for this dimension.
@@ -203,15 +212,11 @@ impl<'a, const D: usize> Run<'a, D> {
                 Basis::LocalMaxEnt(lme)
             }
         };
-        let per_point = match method.shape {
-            ShapeKind::Domain(_) => ParticleDomains::<D>::narrow_nodes_per_point(),
-            shape => footprint::stencil_nodes::<D>(shape),
-        };
         Run {
             resolved,
             method,
-            stencils: Stencils::new(per_point, n),
-            transfer: Transfer::new(&method.transfer, &grid, basis.shape(), &fixed),
+            transfer: Transfer::new(&method.transfer, &grid, basis.shape(&stencils), &fixed),
+            stencils,
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
             remapped: vec![SVector::zeros(); grid.num_nodes()],
@@ -433,15 +438,15 @@ impl<'a, const D: usize> Run<'a, D> {
                 .stencils
                 .update(degree.shape(), &self.grid, &self.particles.x)
                 .map_err(|particle| Divergence::LeftGrid { particle }),
-            Basis::DualDomain(dual) => {
-                dual.integrate(
-                    &self.grid,
-                    &self.particles.x,
-                    &self.particles.volume,
-                    &self.cells,
-                );
-                self.stencils
-                    .update(dual, &self.grid, &self.particles.x)
+            Basis::DualDomain => {
+                let dual = self
+                    .stencils
+                    .update_dual_domain(
+                        &self.grid,
+                        &self.particles.x,
+                        &self.particles.volume,
+                        &self.cells,
+                    )
                     .map_err(|particle| Divergence::LeftGrid { particle })?;
                 self.transfer.refresh_basis(dual);
                 Ok(())
@@ -775,7 +780,12 @@ mod tests {
             let method = run.method;
             // The grid [0, 1] with the body shrunk to its middle, free at both ends.
             run.fixed.clear();
-            run.transfer = Transfer::new(&method.transfer, &run.grid, run.basis.shape(), &[]);
+            run.transfer = Transfer::new(
+                &method.transfer,
+                &run.grid,
+                run.basis.shape(&run.stencils),
+                &[],
+            );
             for p in 0..run.particles.len() {
                 let x = 0.3 + 0.4 * run.particles.x[p][0];
                 run.particles.x[p][0] = x;
