@@ -2,7 +2,8 @@
 //! their own give bit for bit the same record, and the same as outside any pool. The 2D runs
 //! have 4096 particles, four chunks of the per-particle loops, and their grids are cut into
 //! three blocks of nodes; they cover the leapfrog (`mpm`), MUSL and the predictor-corrector,
-//! and a run that diverges.
+//! the dual-domain gradient's node passes (`ddmpm` with MUSL and the leapfrog), and a run
+//! that diverges.
 
 use std::path::Path;
 
@@ -19,6 +20,7 @@ matrix:
   - {method: [mpm, mpm_musl], cfl: [0.2], t_end: [0.004]}
   - {method: [mpm], integrator: [predictor_corrector], cfl: [0.2], t_end: [0.004]}
   - {method: [mpm], cfl: [3.0], t_end: [0.5]}
+  - {method: [ddmpm], integrator: [musl, leapfrog], cfl: [0.2], t_end: [0.004]}
 output: {every: 10}
 ";
 
