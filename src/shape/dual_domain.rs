@@ -61,6 +61,19 @@ fn neighbours_within<const D: usize>(local: &[usize; D], len: usize) -> u32 {
     reached
 }
 
+/// `visit(n, value)` for every node n and its entry of `nodal`, over blocks of nodes in
+/// parallel (`parallel::map_chunks`); each node's work is its own, so any cut gives the same
+/// bits.
+fn per_node<T: Send>(nodal: &mut [T], visit: impl Fn(usize, &mut T) + Sync) {
+    let len = parallel::block_len(nodal.len());
+    let block = |(b, values): (usize, &mut [T])| {
+        for (m, value) in values.iter_mut().enumerate() {
+            visit(b * len + m, value);
+        }
+    };
+    parallel::map_chunks(nodal.chunks_mut(len).enumerate(), block);
+}
+
 /// How the integrals over the material are taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DualIntegrals {
@@ -170,18 +183,13 @@ impl<const D: usize> DualDomain<D> {
     /// zero.
     pub fn velocity_gradients(&self, velocity: &[SVector<f64, D>]) -> Vec<SMatrix<f64, D, D>> {
         let mut out = vec![SMatrix::zeros(); velocity.len()];
-        let len = parallel::block_len(out.len());
-        let fill = |(b, out): (usize, &mut [SMatrix<f64, D, D>])| {
-            for (m, g) in out.iter_mut().enumerate() {
-                let j = b * len + m;
-                if self.volume[j] > 0.0 {
-                    self.for_each_neighbour(j, |o, i| {
-                        *g += velocity[i] * self.average[j * Self::neighbours() + o].transpose();
-                    });
-                }
+        per_node(&mut out, |j, g| {
+            if self.volume[j] > 0.0 {
+                self.for_each_neighbour(j, |o, i| {
+                    *g += velocity[i] * self.average[j * Self::neighbours() + o].transpose();
+                });
             }
-        };
-        parallel::map_chunks(out.chunks_mut(len).enumerate(), fill);
+        });
         out
     }
 
@@ -193,19 +201,14 @@ impl<const D: usize> DualDomain<D> {
         stress: &[SMatrix<f64, D, D>],
         force: &mut [SVector<f64, D>],
     ) {
-        let len = parallel::block_len(force.len());
         // Node j = i + 1 - d is reached from i by the offset o = 2 - d, so that i is j's
         // neighbour d = (3^D - 1) - o.
         let last = Self::neighbours() - 1;
-        let subtract = |(b, force): (usize, &mut [SVector<f64, D>])| {
-            for (m, f) in force.iter_mut().enumerate() {
-                let i = b * len + m;
-                self.for_each_neighbour(i, |o, j| {
-                    *f -= stress[j] * self.average[j * Self::neighbours() + last - o];
-                });
-            }
-        };
-        parallel::map_chunks(force.chunks_mut(len).enumerate(), subtract);
+        per_node(force, |i, f| {
+            self.for_each_neighbour(i, |o, j| {
+                *f -= stress[j] * self.average[j * Self::neighbours() + last - o];
+            });
+        });
     }
 
     /// `visit(o, m)` for each offset o in {0, 1, 2}^D (in base 3, first axis fastest, in
