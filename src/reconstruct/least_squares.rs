@@ -1,8 +1,17 @@
 //! Local least-squares reconstruction of particle data at a lattice of evaluation points
 //! (Gong sec 3.5, Tran eqs 1-17): u^h(x_e) = sum_p phi_p(x_e) u_p with
-//! phi_p(x_e) = w(x_e - x_p) q((x_p - x_e)/h) . c_e. The fit (weights, moments, solve) is
-//! done once per particle configuration and applied to any number of fields, each
-//! application forming the shape functions as it goes.
+//! phi_p(x_e) = w(x_e - x_p) q((x_p - x_e)/h) . c_e. Two ways to apply it:
+//! * `fit` then `apply`: the fit (weights, moments, solve) is done once per particle
+//!   configuration and applied to any number of fields, each application forming the shape
+//!   functions from the stored entries as it goes. For wide data (the quadrature fields).
+//! * `fit_apply`, for a velocity fit applied once: u^h(x_e) = c_e . b_e with the weighted
+//!   moments of the data b_e = sum_p w q u_p summed in the same pass as the moment matrix,
+//!   so one pass over the entries fits and applies, and nothing per entry is stored. The same
+//!   operator as `apply`, its sums in another order: it differs from `apply` by round-off.
+//!   Per entry it costs T D multiply-adds where `apply` costs T + D and a second pass, which
+//!   pays for velocities and not for the quadrature fields' 1 + D^2 + D components.
+//!
+//! `VelocityFit` picks between them for the nodal velocity of a run.
 
 use std::fmt;
 use std::ops::{AddAssign, Mul};
@@ -14,6 +23,7 @@ use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::Kernel;
 use super::lattice::Lattice;
 use super::solve::{mls_coefficients, Moments, Orthogonal};
+use crate::grid::Grid;
 
 /// How the local system is solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,6 +120,9 @@ pub struct Reconstructor<const D: usize> {
     weight: Vec<f64>,
     /// Per evaluation point, its moment matrix packed as `packed_len` describes, then its c_e.
     moments: Vec<f64>,
+    /// Per evaluation point, the moments b_e = sum_p w q u_p of the velocities of the last
+    /// `fit_apply`, `terms` per point.
+    velocity_moments: Vec<SVector<f64, D>>,
     coeffs: Vec<f64>,
     covered: Vec<bool>,
 }
@@ -134,6 +147,7 @@ impl<const D: usize> Reconstructor<D> {
             offset: Vec::new(),
             weight: Vec::new(),
             moments: vec![0.0; points * packed_len(terms)],
+            velocity_moments: Vec::new(),
             coeffs: vec![0.0; points * terms],
             covered: vec![false; points],
             lattice,
@@ -167,6 +181,67 @@ impl<const D: usize> Reconstructor<D> {
         }
     }
 
+    /// Fits at `x` and writes u^h of the velocities `v` to `out` in one pass (module doc).
+    pub fn fit_apply(
+        &mut self,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        out: &mut [SVector<f64, D>],
+    ) -> Result<FitStats, SingularMoments> {
+        // The entries of an earlier `fit` do not belong to this one.
+        self.start.clear();
+        match self.terms {
+            1 => self.fit_apply_with::<1, 1>(x, v, out),
+            2 => self.fit_apply_with::<2, { packed_len(2) }>(x, v, out),
+            3 => self.fit_apply_with::<3, { packed_len(3) }>(x, v, out),
+            MAX_TERMS => self.fit_apply_with::<MAX_TERMS, { packed_len(MAX_TERMS) }>(x, v, out),
+            t => unreachable!("no basis has {t} terms"),
+        }
+    }
+
+    fn fit_apply_with<const T: usize, const P: usize>(
+        &mut self,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        out: &mut [SVector<f64, D>],
+    ) -> Result<FitStats, SingularMoments> {
+        let mut moments = std::mem::take(&mut self.moments);
+        let mut b = std::mem::take(&mut self.velocity_moments);
+        moments.fill(0.0);
+        clear_velocity_moments(&mut b, self.lattice.len() * T);
+        let (a, b_of) = (moments.as_chunks_mut::<P>().0, b.as_chunks_mut::<T>().0);
+        let degree = degree_of::<T, D>();
+        let mut q = [0.0; MAX_TERMS];
+        self.walk(
+            x,
+            |p, _, e, w, d| {
+                monomials(degree, d, &mut q);
+                add_moments::<T, P>(&mut a[e], w, &q);
+                add_velocity_moments::<T, D>(&mut b_of[e], w, &q, v[p]);
+            },
+            |_, _| {},
+        );
+        self.moments = moments;
+        self.velocity_moments = b;
+        let stats = self.solve::<T, P>()?;
+        self.evaluate_velocity::<T>(out);
+        Ok(stats)
+    }
+
+    /// u^h(x_e) = c_e . b_e, zero where no particle reaches.
+    fn evaluate_velocity<const T: usize>(&self, out: &mut [SVector<f64, D>]) {
+        let b_of = self.velocity_moments.as_chunks::<T>().0;
+        let coeffs = self.coeffs.as_chunks::<T>().0;
+        for (e, ((u, b), c)) in out.iter_mut().zip(b_of).zip(coeffs).enumerate() {
+            *u = SVector::zeros();
+            if self.covered[e] {
+                for k in 0..T {
+                    *u += b[k] * c[k];
+                }
+            }
+        }
+    }
+
     fn fit_with<const T: usize, const P: usize>(
         &mut self,
         x: &[SVector<f64, D>],
@@ -186,15 +261,44 @@ impl<const D: usize> Reconstructor<D> {
         self.offset.resize(capacity, SVector::zeros());
         self.weight.resize(capacity, 0.0);
         self.start.resize(x.len() + 1, 0);
-        self.moments.fill(0.0);
-        // Borrowed apart so the loop keeps them in registers.
-        let (lattice, radius, degree) = (&self.lattice, self.radius, degree_of::<T, D>());
-        let (point, offset, weights) = (
-            &mut self.point[..],
-            &mut self.offset[..],
-            &mut self.weight[..],
+        let mut moments = std::mem::take(&mut self.moments);
+        let (mut point, mut offset, mut weight, mut start) = (
+            std::mem::take(&mut self.point),
+            std::mem::take(&mut self.offset),
+            std::mem::take(&mut self.weight),
+            std::mem::take(&mut self.start),
         );
-        let (start, moments) = (&mut self.start[..], self.moments.as_chunks_mut::<P>().0);
+        moments.fill(0.0);
+        let a = moments.as_chunks_mut::<P>().0;
+        let degree = degree_of::<T, D>();
+        let mut q = [0.0; MAX_TERMS];
+        self.walk(
+            x,
+            |_, entry, e, w, d| {
+                point[entry] = e as u32;
+                offset[entry] = *d;
+                weight[entry] = w;
+                monomials(degree, d, &mut q);
+                add_moments::<T, P>(&mut a[e], w, &q);
+            },
+            |p, end| start[p + 1] = end,
+        );
+        self.moments = moments;
+        (self.point, self.offset, self.weight, self.start) = (point, offset, weight, start);
+    }
+
+    /// Calls `visit(p, entry, e, w, d)` for every lattice point e each particle p reaches,
+    /// in particle order and, per particle, the first axis fastest, with the entry's number
+    /// counted from 0, the weight w(x_e - x_p) and the offset d = (x_p - x_e)/h; then
+    /// `particle_done(p, entries so far)`.
+    #[inline(always)]
+    fn walk(
+        &self,
+        x: &[SVector<f64, D>],
+        mut visit: impl FnMut(usize, usize, usize, f64, &SVector<f64, D>),
+        mut particle_done: impl FnMut(usize, usize),
+    ) {
+        let (lattice, radius) = (&self.lattice, self.radius);
         let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
         // Per axis and neighbour: the part of the lattice index, the offset and the 1D
         // weight factor, so each entry only combines them.
@@ -204,7 +308,6 @@ impl<const D: usize> Reconstructor<D> {
         let mut count = [0usize; D];
         let inv_scale = 1.0 / self.recipe.kernel.scale;
         let weight = self.recipe.kernel.weight;
-        let mut q = [0.0; MAX_TERMS];
         let mut entry = 0;
         for (p, xp) in x.iter().enumerate() {
             for k in 0..D {
@@ -215,54 +318,42 @@ impl<const D: usize> Reconstructor<D> {
                     axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
                 }
             }
-            // The entries, first axis fastest, in rows along the first axis: each row's
-            // index part, offsets and weight factors of the other axes are taken once, and
-            // the weight is still the product w_0 w_1 ... in axis order.
-            let total: usize = count.iter().product();
+            // In rows along the first axis: each row's index part and offsets of the other
+            // axes are taken once, and the weight is still the product w_0 w_1 ... in axis
+            // order.
             let along = count[0];
-            if total > 0 {
-                let rows = point[entry..][..total]
-                    .chunks_exact_mut(along)
-                    .zip(offset[entry..][..total].chunks_exact_mut(along))
-                    .zip(weights[entry..][..total].chunks_exact_mut(along));
-                let mut j = [0usize; D];
-                for ((row_point, row_offset), row_weight) in rows {
-                    let mut row_index = 0;
-                    let mut d = SVector::<f64, D>::zeros();
+            let rows: usize = if along == 0 {
+                0
+            } else {
+                count[1..].iter().product()
+            };
+            let mut j = [0usize; D];
+            for _ in 0..rows {
+                let mut row_index = 0;
+                let mut d = SVector::<f64, D>::zeros();
+                for k in 1..D {
+                    row_index += index[k][j[k]];
+                    d[k] = axis_offset[k][j[k]];
+                }
+                for i in 0..along {
+                    let mut w = axis_weight[0][i];
                     for k in 1..D {
-                        row_index += index[k][j[k]];
-                        d[k] = axis_offset[k][j[k]];
+                        w *= axis_weight[k][j[k]];
                     }
-                    let first = index[0][..along]
-                        .iter()
-                        .zip(&axis_offset[0][..along])
-                        .zip(&axis_weight[0][..along]);
-                    let entries = row_point.iter_mut().zip(row_offset).zip(row_weight);
-                    for (((e, d_out), w_out), ((&i, &d0), &w0)) in entries.zip(first) {
-                        let mut w = w0;
-                        for k in 1..D {
-                            w *= axis_weight[k][j[k]];
-                        }
-                        d[0] = d0;
-                        let e_full = i + row_index;
-                        *e = e_full as u32;
-                        *d_out = d;
-                        *w_out = w;
-                        monomials(degree, &d, &mut q);
-                        add_moments::<T, P>(&mut moments[e_full], w, &q);
+                    d[0] = axis_offset[0][i];
+                    visit(p, entry, index[0][i] + row_index, w, &d);
+                    entry += 1;
+                }
+                // The next row: an odometer over the axes after the first.
+                for k in 1..D {
+                    j[k] += 1;
+                    if j[k] < count[k] {
+                        break;
                     }
-                    // The next row: an odometer over the axes after the first.
-                    for k in 1..D {
-                        j[k] += 1;
-                        if j[k] < count[k] {
-                            break;
-                        }
-                        j[k] = 0;
-                    }
+                    j[k] = 0;
                 }
             }
-            entry += total;
-            start[p + 1] = entry;
+            particle_done(p, entry);
         }
     }
 
@@ -324,7 +415,7 @@ impl<const D: usize> Reconstructor<D> {
         out.fill(V::zero());
         assert!(
             values.len() < self.start.len(),
-            "more values than fitted particles"
+            "more values than particles in the last `fit`"
         );
         let degree = degree_of::<T, D>();
         let coeffs = self.coeffs.as_chunks::<T>().0;
@@ -349,6 +440,49 @@ impl<const D: usize> Reconstructor<D> {
     }
 }
 
+/// The least-squares fit of the particle velocities at the grid nodes, refitted every step.
+/// A run that rebuilds the nodal velocity from the moved particles (MUSL) applies the step's
+/// fit twice and keeps its entries (`fit`, `apply`); otherwise it is fitted and applied in one
+/// pass (`fit_apply`), which is cheaper for one application and differs from the other by
+/// round-off.
+pub struct VelocityFit<const D: usize> {
+    fit: Reconstructor<D>,
+    remaps: bool,
+}
+
+impl<const D: usize> VelocityFit<D> {
+    pub fn new(recipe: Recipe, grid: &Grid<D>, remaps: bool) -> Self {
+        VelocityFit {
+            fit: Reconstructor::new(recipe, Lattice::nodes(grid)),
+            remaps,
+        }
+    }
+
+    /// The nodal velocity `out` from the particles at `x` with velocities `v`.
+    pub fn map(
+        &mut self,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        out: &mut [SVector<f64, D>],
+    ) -> Result<FitStats, SingularMoments> {
+        if !self.remaps {
+            return self.fit.fit_apply(x, v, out);
+        }
+        let stats = self.fit.fit(x)?;
+        self.fit.apply(v, out);
+        Ok(stats)
+    }
+
+    /// The last mapping's fit applied to the velocities `v` now.
+    pub fn remap(&self, v: &[SVector<f64, D>], out: &mut [SVector<f64, D>]) {
+        assert!(
+            self.remaps,
+            "a velocity fit built without remapping remapped"
+        );
+        self.fit.apply(v, out);
+    }
+}
+
 /// A moment matrix A = sum w q q^T packed for summing: row 0, then rows 1.. without their
 /// first entry, row-major. The monomials start with q_0 = 1, so entry (r, 0) would receive
 /// (w q_r) 1 = w q_r, the bits that (0, r) receives as (w 1) q_r: column 0 below row 0 is
@@ -369,6 +503,28 @@ fn add_moments<const T: usize, const P: usize>(a: &mut [f64; P], w: f64, q: &[f6
         for s in 1..T {
             a[T + (r - 1) * (T - 1) + s - 1] += wq[r] * q[s];
         }
+    }
+}
+
+/// b_e is resized to `len` entries and zeroed.
+fn clear_velocity_moments<const D: usize>(b: &mut Vec<SVector<f64, D>>, len: usize) {
+    b.clear();
+    b.resize(len, SVector::zeros());
+}
+
+/// b += u (w q), term by term; an entry of zero weight adds nothing, whatever u holds.
+#[inline(always)]
+fn add_velocity_moments<const T: usize, const D: usize>(
+    b: &mut [SVector<f64, D>; T],
+    w: f64,
+    q: &[f64; MAX_TERMS],
+    u: SVector<f64, D>,
+) {
+    if w == 0.0 {
+        return;
+    }
+    for k in 0..T {
+        b[k] += u * (w * q[k]);
     }
 }
 

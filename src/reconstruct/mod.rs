@@ -30,7 +30,7 @@ pub use kind::{
 };
 pub use lattice::Lattice;
 pub use least_squares::{
-    FitStats, Recipe, Reconstructor, SingularMoments, Solver, MAX_NODE_SUPPORT_CELLS,
+    FitStats, Recipe, Reconstructor, SingularMoments, Solver, VelocityFit, MAX_NODE_SUPPORT_CELLS,
 };
 pub use mass_matrix::{MassMatrix, MassSolver};
 pub use quadrature::{

@@ -11,7 +11,7 @@ use nalgebra::{SMatrix, SVector};
 use num_traits::Zero;
 
 use super::shepard::{map_velocity, remap_velocity};
-use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments};
+use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments, VelocityFit};
 use crate::catalog::{names_of, Catalog, Entry, Parts};
 use crate::grid::{Grid, GridState};
 use crate::particles::Particles;
@@ -95,7 +95,7 @@ impl BodyForceFit {
 
 /// The nodal velocity of a quadrature transfer as it is computed.
 enum VelocityMap<const D: usize> {
-    Fit(Box<Reconstructor<D>>),
+    Fit(Box<VelocityFit<D>>),
     /// With the Shepard masses sum_p M_p N_ip of the last mapping, which MUSL's remap
     /// divides by.
     Shepard(Vec<f64>),
@@ -172,7 +172,8 @@ impl<const D: usize> Mul<f64> for Fields<D> {
 }
 
 impl<const D: usize> QuadratureTransfer<D> {
-    pub fn new(recipe: &QuadratureRecipe, grid: &Grid<D>) -> Self {
+    /// `remaps`: whether the run rebuilds the nodal velocity after the particles move.
+    pub fn new(recipe: &QuadratureRecipe, grid: &Grid<D>, remaps: bool) -> Self {
         let points = Lattice::gauss(grid, recipe.gauss_points);
         let n = points.len();
         let positions: Vec<SVector<f64, D>> = (0..n).map(|g| points.point(g)).collect();
@@ -184,7 +185,7 @@ impl<const D: usize> QuadratureTransfer<D> {
         QuadratureTransfer {
             velocity: match recipe.velocity {
                 NodalVelocity::Fit(fit) => {
-                    VelocityMap::Fit(Box::new(Reconstructor::new(fit, Lattice::nodes(grid))))
+                    VelocityMap::Fit(Box::new(VelocityFit::new(fit, grid, remaps)))
                 }
                 NodalVelocity::Shepard => VelocityMap::Shepard(Vec::new()),
             },
@@ -214,8 +215,7 @@ impl<const D: usize> QuadratureTransfer<D> {
         match &mut self.velocity {
             VelocityMap::Fit(fit) => {
                 grid.clear();
-                stats += fit.fit(&particles.x)?;
-                fit.apply(&particles.v, &mut grid.velocity);
+                stats += fit.map(&particles.x, &particles.v, &mut grid.velocity)?;
             }
             VelocityMap::Shepard(mass) => {
                 map_velocity(stencils, &particles.mass, &particles.v, grid);
@@ -263,7 +263,7 @@ impl<const D: usize> QuadratureTransfer<D> {
         out: &mut [SVector<f64, D>],
     ) {
         match &self.velocity {
-            VelocityMap::Fit(fit) => fit.apply(&particles.v, out),
+            VelocityMap::Fit(fit) => fit.remap(&particles.v, out),
             VelocityMap::Shepard(mass) => {
                 remap_velocity(stencils, particles, mass, empty_mass, out)
             }
@@ -325,7 +325,7 @@ mod tests {
         let total: f64 = particles.mass.iter().sum();
         let stencils = hat_stencils(&grid, &particles.x);
         for recipe in recipes() {
-            let mut transfer = QuadratureTransfer::new(&recipe, &grid);
+            let mut transfer = QuadratureTransfer::new(&recipe, &grid, false);
             let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
             let stats = transfer
                 .map_to_grid(&stencils, &particles, &body, &mut nodes)
@@ -380,7 +380,7 @@ mod tests {
         let body = vec![SVector::<f64, D>::from_fn(|k, _| 2.0 - k as f64); particles.len()];
         let stencils = hat_stencils(&grid, &particles.x);
         let map = |nodes: &mut GridState<D>, recipe: Option<QuadratureRecipe>| {
-            let mut transfer = recipe.map(|r| QuadratureTransfer::new(&r, &grid));
+            let mut transfer = recipe.map(|r| QuadratureTransfer::new(&r, &grid, true));
             match &mut transfer {
                 Some(t) => {
                     t.map_to_grid(&stencils, &particles, &body, nodes).unwrap();
@@ -492,7 +492,7 @@ mod tests {
                 let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
                 match recipe {
                     Some(r) => {
-                        QuadratureTransfer::new(&r, &grid)
+                        QuadratureTransfer::new(&r, &grid, false)
                             .map_to_grid(&stencils, &particles, &b, &mut nodes)
                             .unwrap();
                     }
@@ -605,7 +605,7 @@ mod tests {
         };
         let stencils = hat_stencils(&grid, &particles.x);
         let force = |body_force| {
-            let mut transfer = QuadratureTransfer::new(&recipe(body_force), &grid);
+            let mut transfer = QuadratureTransfer::new(&recipe(body_force), &grid, false);
             let mut nodes = GridState::new(grid.num_nodes(), particles.mass[0]);
             transfer
                 .map_to_grid(&stencils, &particles, &body, &mut nodes)

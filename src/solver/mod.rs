@@ -215,7 +215,13 @@ impl<'a, const D: usize> Run<'a, D> {
         Run {
             resolved,
             method,
-            transfer: Transfer::new(&method.transfer, &grid, basis.shape(&stencils), &fixed),
+            transfer: Transfer::new(
+                &method.transfer,
+                &grid,
+                basis.shape(&stencils),
+                &fixed,
+                method.integrator.remaps_velocity(),
+            ),
             stencils,
             basis,
             nodes: GridState::new(grid.num_nodes(), particle_mass),
@@ -785,6 +791,7 @@ mod tests {
                 &run.grid,
                 run.basis.shape(&run.stencils),
                 &[],
+                method.integrator.remaps_velocity(),
             );
             for p in 0..run.particles.len() {
                 let x = 0.3 + 0.4 * run.particles.x[p][0];

@@ -8,8 +8,8 @@ use crate::integrate;
 use crate::particles::Particles;
 use crate::reconstruct::TransferKind;
 use crate::reconstruct::{
-    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, Lattice,
-    QuadratureTransfer, Reconstructor, TaylorTransfer,
+    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, QuadratureTransfer,
+    TaylorTransfer, VelocityFit,
 };
 use crate::shape::{Shape, Stencils};
 
@@ -17,7 +17,7 @@ pub enum Transfer<const D: usize> {
     Shepard,
     Quadrature(Box<QuadratureTransfer<D>>),
     /// The Shepard transfer with the nodal velocity replaced by this fit at the nodes.
-    FittedVelocity(Box<Reconstructor<D>>),
+    FittedVelocity(Box<VelocityFit<D>>),
     /// The Shepard sums solved with the consistent mass matrix.
     ConsistentMass(Box<ConsistentMassTransfer<D>>),
     /// Taylor least squares per element with its own mass matrix.
@@ -26,12 +26,14 @@ pub enum Transfer<const D: usize> {
 
 impl<const D: usize> Transfer<D> {
     /// `basis` is the run's grid basis, for transfers that evaluate it at quadrature points
-    /// of their own.
+    /// of their own; `remaps` whether the integrator rebuilds the nodal velocity after the
+    /// particles move (`remap_velocity`).
     pub fn new(
         kind: &TransferKind,
         grid: &Grid<D>,
         basis: &dyn Shape<D>,
         fixed: &[FixedDof],
+        remaps: bool,
     ) -> Self {
         match kind {
             TransferKind::Shepard => Transfer::Shepard,
@@ -39,11 +41,11 @@ impl<const D: usize> Transfer<D> {
                 ConsistentMassTransfer::new(grid.nodes_per_dim(), fixed),
             )),
             TransferKind::Quadrature(recipe) => {
-                Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid)))
+                Transfer::Quadrature(Box::new(QuadratureTransfer::new(recipe, grid, remaps)))
             }
-            TransferKind::FittedVelocity(recipe) => Transfer::FittedVelocity(Box::new(
-                Reconstructor::new(*recipe, Lattice::nodes(grid)),
-            )),
+            TransferKind::FittedVelocity(recipe) => {
+                Transfer::FittedVelocity(Box::new(VelocityFit::new(*recipe, grid, remaps)))
+            }
             TransferKind::Taylor(recipe) => {
                 Transfer::Taylor(Box::new(TaylorTransfer::new(*recipe, grid, basis, fixed)))
             }
@@ -69,9 +71,8 @@ impl<const D: usize> Transfer<D> {
             Transfer::FittedVelocity(fit) => {
                 particles_to_grid(stencils, particles, body_force, grid);
                 let stats = fit
-                    .fit(&particles.x)
+                    .map(&particles.x, &particles.v, &mut grid.velocity)
                     .map_err(|e| Divergence::Reconstruction(e.to_string()))?;
-                fit.apply(&particles.v, &mut grid.velocity);
                 Ok(stats)
             }
             Transfer::ConsistentMass(cm) => cm
@@ -132,7 +133,7 @@ impl<const D: usize> Transfer<D> {
                 remap_velocity(stencils, particles, &grid.mass, grid.empty_mass, out)
             }
             Transfer::Quadrature(q) => q.remap_velocity(stencils, particles, grid.empty_mass, out),
-            Transfer::FittedVelocity(fit) => fit.apply(&particles.v, out),
+            Transfer::FittedVelocity(fit) => fit.remap(&particles.v, out),
             Transfer::ConsistentMass(cm) => {
                 return cm.remap_velocity(stencils, particles, grid, out)
             }
