@@ -205,31 +205,29 @@ impl<const D: usize> Reconstructor<D> {
         v: &[SVector<f64, D>],
         out: &mut [SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
-        let mut moments = std::mem::take(&mut self.moments);
-        let mut b = std::mem::take(&mut self.velocity_moments);
-        moments.fill(0.0);
-        clear_velocity_moments(&mut b, self.lattice.len() * T);
-        let (a, b_of) = (moments.as_chunks_mut::<P>().0, b.as_chunks_mut::<T>().0);
+        self.moments.fill(0.0);
+        self.velocity_moments.clear();
+        self.velocity_moments
+            .resize(self.lattice.len() * T, SVector::zeros());
+        let a = self.moments.as_chunks_mut::<P>().0;
+        let b_of = self.velocity_moments.as_chunks_mut::<T>().0;
         let degree = degree_of::<T, D>();
         let mut q = [0.0; MAX_TERMS];
-        self.walk(
+        let visit = |p: usize, _, e: usize, w, d: &SVector<f64, D>| {
+            monomials(degree, d, &mut q);
+            add_moments::<T, P>(&mut a[e], w, &q);
+            add_velocity_moments::<T, D>(&mut b_of[e], w, &q, v[p]);
+        };
+        walk(
+            &self.lattice,
+            self.radius,
+            &self.recipe.kernel,
             x,
-            |p, _, e, w, d| {
-                monomials(degree, d, &mut q);
-                add_moments::<T, P>(&mut a[e], w, &q);
-                add_velocity_moments::<T, D>(&mut b_of[e], w, &q, v[p]);
-            },
+            visit,
             |_, _| {},
         );
-        self.moments = moments;
-        self.velocity_moments = b;
         let stats = self.solve::<T, P>()?;
-        self.evaluate_velocity::<T>(out);
-        Ok(stats)
-    }
-
-    /// u^h(x_e) = c_e . b_e, zero where no particle reaches.
-    fn evaluate_velocity<const T: usize>(&self, out: &mut [SVector<f64, D>]) {
+        // u^h(x_e) = c_e . b_e, zero where no particle reaches.
         let b_of = self.velocity_moments.as_chunks::<T>().0;
         let coeffs = self.coeffs.as_chunks::<T>().0;
         for (e, ((u, b), c)) in out.iter_mut().zip(b_of).zip(coeffs).enumerate() {
@@ -240,6 +238,7 @@ impl<const D: usize> Reconstructor<D> {
                 }
             }
         }
+        Ok(stats)
     }
 
     fn fit_with<const T: usize, const P: usize>(
@@ -261,100 +260,32 @@ impl<const D: usize> Reconstructor<D> {
         self.offset.resize(capacity, SVector::zeros());
         self.weight.resize(capacity, 0.0);
         self.start.resize(x.len() + 1, 0);
-        let mut moments = std::mem::take(&mut self.moments);
-        let (mut point, mut offset, mut weight, mut start) = (
-            std::mem::take(&mut self.point),
-            std::mem::take(&mut self.offset),
-            std::mem::take(&mut self.weight),
-            std::mem::take(&mut self.start),
+        self.moments.fill(0.0);
+        let a = self.moments.as_chunks_mut::<P>().0;
+        let (point, offset, weight, start) = (
+            &mut self.point,
+            &mut self.offset,
+            &mut self.weight,
+            &mut self.start,
         );
-        moments.fill(0.0);
-        let a = moments.as_chunks_mut::<P>().0;
         let degree = degree_of::<T, D>();
         let mut q = [0.0; MAX_TERMS];
-        self.walk(
+        let visit = |_, entry: usize, e: usize, w, d: &SVector<f64, D>| {
+            point[entry] = e as u32;
+            offset[entry] = *d;
+            weight[entry] = w;
+            monomials(degree, d, &mut q);
+            add_moments::<T, P>(&mut a[e], w, &q);
+        };
+        let particle_done = |p: usize, end| start[p + 1] = end;
+        walk(
+            &self.lattice,
+            self.radius,
+            &self.recipe.kernel,
             x,
-            |_, entry, e, w, d| {
-                point[entry] = e as u32;
-                offset[entry] = *d;
-                weight[entry] = w;
-                monomials(degree, d, &mut q);
-                add_moments::<T, P>(&mut a[e], w, &q);
-            },
-            |p, end| start[p + 1] = end,
+            visit,
+            particle_done,
         );
-        self.moments = moments;
-        (self.point, self.offset, self.weight, self.start) = (point, offset, weight, start);
-    }
-
-    /// Calls `visit(p, entry, e, w, d)` for every lattice point e each particle p reaches,
-    /// in particle order and, per particle, the first axis fastest, with the entry's number
-    /// counted from 0, the weight w(x_e - x_p) and the offset d = (x_p - x_e)/h; then
-    /// `particle_done(p, entries so far)`.
-    #[inline(always)]
-    fn walk(
-        &self,
-        x: &[SVector<f64, D>],
-        mut visit: impl FnMut(usize, usize, usize, f64, &SVector<f64, D>),
-        mut particle_done: impl FnMut(usize, usize),
-    ) {
-        let (lattice, radius) = (&self.lattice, self.radius);
-        let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
-        // Per axis and neighbour: the part of the lattice index, the offset and the 1D
-        // weight factor, so each entry only combines them.
-        let mut index = [[0usize; MAX_PER_AXIS]; D];
-        let mut axis_offset = [[0.0f64; MAX_PER_AXIS]; D];
-        let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
-        let mut count = [0usize; D];
-        let inv_scale = 1.0 / self.recipe.kernel.scale;
-        let weight = self.recipe.kernel.weight;
-        let mut entry = 0;
-        for (p, xp) in x.iter().enumerate() {
-            for k in 0..D {
-                count[k] = lattice.near_on_axis(k, xp[k], radius, &mut near);
-                for (j, &(i, dk)) in near[..count[k]].iter().enumerate() {
-                    index[k][j] = i * lattice.stride(k);
-                    axis_offset[k][j] = -dk;
-                    axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
-                }
-            }
-            // In rows along the first axis: each row's index part and offsets of the other
-            // axes are taken once, and the weight is still the product w_0 w_1 ... in axis
-            // order.
-            let along = count[0];
-            let rows: usize = if along == 0 {
-                0
-            } else {
-                count[1..].iter().product()
-            };
-            let mut j = [0usize; D];
-            for _ in 0..rows {
-                let mut row_index = 0;
-                let mut d = SVector::<f64, D>::zeros();
-                for k in 1..D {
-                    row_index += index[k][j[k]];
-                    d[k] = axis_offset[k][j[k]];
-                }
-                for i in 0..along {
-                    let mut w = axis_weight[0][i];
-                    for k in 1..D {
-                        w *= axis_weight[k][j[k]];
-                    }
-                    d[0] = axis_offset[0][i];
-                    visit(p, entry, index[0][i] + row_index, w, &d);
-                    entry += 1;
-                }
-                // The next row: an odometer over the axes after the first.
-                for k in 1..D {
-                    j[k] += 1;
-                    if j[k] < count[k] {
-                        break;
-                    }
-                    j[k] = 0;
-                }
-            }
-            particle_done(p, entry);
-        }
     }
 
     /// The coefficients c_e at every evaluation point.
@@ -440,6 +371,77 @@ impl<const D: usize> Reconstructor<D> {
     }
 }
 
+/// Calls `visit(p, entry, e, w, d)` for every lattice point e each particle p reaches,
+/// in particle order and, per particle, the first axis fastest, with the entry's number
+/// counted from 0, the weight w(x_e - x_p) and the offset d = (x_p - x_e)/h; then
+/// `particle_done(p, entries so far)`. `radius` is the kernel's in cells.
+#[inline(always)]
+fn walk<const D: usize>(
+    lattice: &Lattice<D>,
+    radius: f64,
+    kernel: &Kernel,
+    x: &[SVector<f64, D>],
+    mut visit: impl FnMut(usize, usize, usize, f64, &SVector<f64, D>),
+    mut particle_done: impl FnMut(usize, usize),
+) {
+    let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
+    // Per axis and neighbour: the part of the lattice index, the offset and the 1D
+    // weight factor, so each entry only combines them.
+    let mut index = [[0usize; MAX_PER_AXIS]; D];
+    let mut axis_offset = [[0.0f64; MAX_PER_AXIS]; D];
+    let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
+    let mut count = [0usize; D];
+    let inv_scale = 1.0 / kernel.scale;
+    let weight = kernel.weight;
+    let mut entry = 0;
+    for (p, xp) in x.iter().enumerate() {
+        for k in 0..D {
+            count[k] = lattice.near_on_axis(k, xp[k], radius, &mut near);
+            for (j, &(i, dk)) in near[..count[k]].iter().enumerate() {
+                index[k][j] = i * lattice.stride(k);
+                axis_offset[k][j] = -dk;
+                axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
+            }
+        }
+        // In rows along the first axis: each row's index part and offsets of the other
+        // axes are taken once, and the weight is still the product w_0 w_1 ... in axis
+        // order.
+        let along = count[0];
+        let rows: usize = if along == 0 {
+            0
+        } else {
+            count[1..].iter().product()
+        };
+        let mut j = [0usize; D];
+        for _ in 0..rows {
+            let mut row_index = 0;
+            let mut d = SVector::<f64, D>::zeros();
+            for k in 1..D {
+                row_index += index[k][j[k]];
+                d[k] = axis_offset[k][j[k]];
+            }
+            for i in 0..along {
+                let mut w = axis_weight[0][i];
+                for k in 1..D {
+                    w *= axis_weight[k][j[k]];
+                }
+                d[0] = axis_offset[0][i];
+                visit(p, entry, index[0][i] + row_index, w, &d);
+                entry += 1;
+            }
+            // The next row: an odometer over the axes after the first.
+            for k in 1..D {
+                j[k] += 1;
+                if j[k] < count[k] {
+                    break;
+                }
+                j[k] = 0;
+            }
+        }
+        particle_done(p, entry);
+    }
+}
+
 /// The least-squares fit of the particle velocities at the grid nodes, refitted every step.
 /// A run that rebuilds the nodal velocity from the moved particles (MUSL) applies the step's
 /// fit twice and keeps its entries (`fit`, `apply`); otherwise it is fitted and applied in one
@@ -504,12 +506,6 @@ fn add_moments<const T: usize, const P: usize>(a: &mut [f64; P], w: f64, q: &[f6
             a[T + (r - 1) * (T - 1) + s - 1] += wq[r] * q[s];
         }
     }
-}
-
-/// b_e is resized to `len` entries and zeroed.
-fn clear_velocity_moments<const D: usize>(b: &mut Vec<SVector<f64, D>>, len: usize) {
-    b.clear();
-    b.resize(len, SVector::zeros());
 }
 
 /// b += u (w q), term by term; an entry of zero weight adds nothing, whatever u holds.
