@@ -4,7 +4,7 @@
 use nalgebra::SVector;
 
 use crate::gauss::gauss_legendre;
-use crate::grid::{lattice_strides, Dofs, Grid};
+use crate::grid::{index_to_f64, lattice_strides, Dofs, Grid};
 
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
@@ -92,41 +92,38 @@ impl<const D: usize> Lattice<D> {
         // i64, which converts in one instruction where usize does not.
         let first_cell = ((s - radius - self.last_offset()) as i64).max(0) as usize;
         let last_cell = ((s + radius) as i64).max(0) as usize;
-        let mut n = 0;
         // Cells, then offsets within a cell: lattice index order without a division. The
         // offsets d grow with the index (rounding is monotone), so the points within the
-        // radius are one run, and the first point at or past it ends the search. A cell's
-        // coordinate goes through i64, whose conversion to f64 is one instruction (usize's
-        // several).
+        // radius are one run, and the first point at or past it ends the search. Every cell
+        // holds k points, so none lies in the cells past the lattice's last.
+        let cells = first_cell..(last_cell + 1).min(self.per_axis / k);
+        let mut n = 0;
+        // Takes point i at offset d if it is within the radius; false once past it.
+        let mut take = |i: usize, d: f64| {
+            if d >= radius {
+                return false;
+            }
+            if d > -radius {
+                out[n] = (i, d);
+                n += 1;
+            }
+            true
+        };
         if let [offset] = self.offsets[..] {
             // One point per cell (the nodes, the cell centres: every velocity fit and IMPM's
             // fields), the cell its index: the loop over the offsets below cost `impm` 5 % of
             // its instructions.
-            for cell in first_cell..(last_cell + 1).min(self.per_axis) {
-                let d = (cell as i64 as f64 + offset) - s;
-                if d >= radius {
+            for cell in cells {
+                if !take(cell, (index_to_f64(cell) + offset) - s) {
                     break;
                 }
-                if d > -radius {
-                    out[n] = (cell, d);
-                    n += 1;
-                }
             }
-            return n;
-        }
-        'cells: for cell in first_cell..=last_cell {
-            for (j, &offset) in self.offsets.iter().enumerate() {
-                let i = cell * k + j;
-                if i >= self.per_axis {
-                    break 'cells;
-                }
-                let d = (cell as i64 as f64 + offset) - s;
-                if d >= radius {
-                    break 'cells;
-                }
-                if d > -radius {
-                    out[n] = (i, d);
-                    n += 1;
+        } else {
+            'cells: for cell in cells {
+                for (j, &offset) in self.offsets.iter().enumerate() {
+                    if !take(cell * k + j, (index_to_f64(cell) + offset) - s) {
+                        break 'cells;
+                    }
                 }
             }
         }

@@ -15,7 +15,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::block::{block_from, next_block_entry};
 use super::{Shape, Stencils};
-use crate::grid::{Dofs, Grid};
+use crate::grid::{index_to_f64, Dofs, Grid};
 
 /// Default neighbour cut-off (Molinos et al. sec 5): nodes whose prior weight
 /// exp(-beta |x - x_a|^2) is below it are left out.
@@ -633,10 +633,10 @@ impl Rows {
 }
 
 /// The scaled offset s - node of the node numbered `node` along an axis from the scaled
-/// position `s`; i64's conversion to f64 is one instruction, usize's several.
+/// position `s`.
 #[inline]
 fn block_offset(s: f64, node: usize) -> f64 {
-    s - node as i64 as f64
+    s - index_to_f64(node)
 }
 
 /// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'

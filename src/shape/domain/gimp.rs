@@ -1,5 +1,7 @@
 //! GIMP (Gong sec 6.3): the hat averaged over an axis-aligned box, one axis at a time.
 
+use crate::grid::index_to_f64;
+
 /// The integral of the unit hat max(0, 1 - |t|) from -infinity to `xi`.
 #[inline]
 fn hat_integral(xi: f64) -> f64 {
@@ -28,8 +30,7 @@ pub(super) fn hat(xi: f64) -> f64 {
 pub(super) fn averaged_hats(a: f64, b: f64, first: usize, value: &mut [f64], slope: &mut [f64]) {
     let inv_len = 1.0 / (b - a);
     for (j, (s, ds)) in value.iter_mut().zip(slope.iter_mut()).enumerate() {
-        // Through i64, whose conversion to f64 is one instruction.
-        let node = (first + j) as i64 as f64;
+        let node = index_to_f64(first + j);
         *s = (hat_integral(b - node) - hat_integral(a - node)) * inv_len;
         *ds = (hat(b - node) - hat(a - node)) * inv_len;
     }

@@ -17,7 +17,7 @@ use nalgebra::SVector;
 use super::block::{block_start, for_each_block_node, NODES_PER_AXIS};
 use super::{LinearHat, Shape, Stencils};
 use crate::divergence::DomainFault;
-use crate::grid::{lattice_coords, lattice_strides, Grid};
+use crate::grid::{index_to_f64, lattice_coords, lattice_strides, Grid};
 use crate::particles::Particles;
 use cpdi::{corner_weights, reference_corner, MAX_CORNERS};
 use gimp::{averaged_hats, hat};
@@ -304,8 +304,7 @@ fn fill_corners<const D: usize, const A: usize>(
         let s = local(c);
         for k in 0..D {
             for j in 0..A {
-                // Through i64, whose conversion to f64 is one instruction.
-                hats[a][k][j] = hat(s[k] - (start[k] + j) as i64 as f64);
+                hats[a][k][j] = hat(s[k] - index_to_f64(start[k] + j));
             }
         }
     }
