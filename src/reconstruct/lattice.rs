@@ -16,6 +16,9 @@ pub struct Lattice<const D: usize> {
     offsets: Vec<f64>,
     /// Points per axis.
     per_axis: usize,
+    /// Cells per axis that hold points, `per_axis / offsets.len()`: for the nodes one more
+    /// than the grid's, the upper face's node counting as a cell of its own.
+    cells: usize,
     strides: [usize; D],
 }
 
@@ -25,6 +28,7 @@ impl<const D: usize> Lattice<D> {
         Lattice {
             lower: grid.lower,
             h: grid.h,
+            cells: per_axis / offsets.len(),
             offsets,
             per_axis,
             strides,
@@ -73,16 +77,17 @@ impl<const D: usize> Lattice<D> {
         })
     }
 
-    /// Along `axis`, the lattice indices strictly within `radius` (in units of h) of `x`,
-    /// each with its offset (x_point - x)/h, written into `out`; returns how many. `out`
-    /// must hold `max_per_axis(radius)` entries.
-    #[inline]
+    /// Along `axis`, the lattice indices strictly within `radius` (in units of h) of `x`, in
+    /// index order: `found(n, i, d)` for the n-th of them, index i, offset d = (x_i - x)/h.
+    /// Returns how many; at most `max_per_axis(radius)`. The callback lets a caller tabulate
+    /// what it needs of each point as it is found, without a list in between.
+    #[inline(always)]
     pub fn near_on_axis(
         &self,
         axis: usize,
         x: f64,
         radius: f64,
-        out: &mut [(usize, f64)],
+        mut found: impl FnMut(usize, usize, f64),
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
@@ -96,7 +101,7 @@ impl<const D: usize> Lattice<D> {
         // offsets d grow with the index (rounding is monotone), so the points within the
         // radius are one run, and the first point at or past it ends the search. Every cell
         // holds k points, so none lies in the cells past the lattice's last.
-        let cells = first_cell..(last_cell + 1).min(self.per_axis / k);
+        let cells = first_cell..(last_cell + 1).min(self.cells);
         let mut n = 0;
         // Takes point i at offset d if it is within the radius; false once past it.
         let mut take = |i: usize, d: f64| {
@@ -104,7 +109,7 @@ impl<const D: usize> Lattice<D> {
                 return false;
             }
             if d > -radius {
-                out[n] = (i, d);
+                found(n, i, d);
                 n += 1;
             }
             true
@@ -204,6 +209,19 @@ mod tests {
         }
     }
 
+    /// `near_on_axis`'s points on the first axis, checking the slots and the bound on their
+    /// number.
+    fn near(lattice: &Lattice<1>, x: f64, radius: f64) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        let n = lattice.near_on_axis(0, x, radius, |n, i, d| {
+            assert_eq!(n, out.len());
+            out.push((i, d));
+        });
+        assert_eq!(n, out.len());
+        assert!(n <= lattice.max_per_axis(radius));
+        out
+    }
+
     /// `near_on_axis` finds exactly the points within the radius, for points anywhere.
     #[test]
     fn near_on_axis_is_exhaustive() {
@@ -214,10 +232,9 @@ mod tests {
             Lattice::gauss(&g, 2),
         ] {
             for radius in [1.0, 1.5, 2.0, 3.0] {
-                let mut out = vec![(0, 0.0); lattice.max_per_axis(radius)];
                 for &x in &[-1.0, -0.93, -0.2, 0.0, 0.41, 0.99, 1.0] {
-                    let n = lattice.near_on_axis(0, x, radius, &mut out);
-                    let found: Vec<usize> = out[..n].iter().map(|e| e.0).collect();
+                    let out = near(&lattice, x, radius);
+                    let found: Vec<usize> = out.iter().map(|e| e.0).collect();
                     // Points at exactly the radius have zero weight: either answer is right.
                     for i in 0..lattice.len() {
                         let d = ((lattice.point(i)[0] - x) / g.h).abs();
@@ -227,7 +244,7 @@ mod tests {
                             assert!(!found.contains(&i), "x = {x}, radius {radius}: {i}");
                         }
                     }
-                    for &(i, d) in &out[..n] {
+                    for &(i, d) in &out {
                         assert!((d - (lattice.point(i)[0] - x) / g.h).abs() < 1e-12);
                     }
                 }
@@ -249,7 +266,6 @@ mod tests {
         ] {
             let k = lattice.offsets.len();
             for radius in [0.5, 1.0, 1.5, 2.0, 3.0] {
-                let mut out = vec![(0, 0.0); lattice.max_per_axis(radius)];
                 for trial in 0..2000 {
                     // Random points, and points on the lattice and the cell faces.
                     let x = match trial % 3 {
@@ -262,8 +278,7 @@ mod tests {
                         .map(|i| (i, ((i / k) as f64 + lattice.offsets[i % k]) - s))
                         .filter(|&(_, d)| d.abs() < radius)
                         .collect();
-                    let n = lattice.near_on_axis(0, x, radius, &mut out);
-                    let found = &out[..n];
+                    let found = near(&lattice, x, radius);
                     assert_eq!(found.len(), every.len(), "x = {x}, radius {radius}");
                     for (a, b) in found.iter().zip(&every) {
                         assert_eq!((a.0, a.1.to_bits()), (b.0, b.1.to_bits()), "x = {x}");

@@ -108,16 +108,18 @@ pub struct Reconstructor<const D: usize> {
     lattice: Lattice<D>,
     terms: usize,
     radius: f64,
-    /// The most lattice points one particle reaches.
-    max_entries: usize,
-    /// Particle p's entries are `start[p]..start[p + 1]`: the lattice points it reaches,
-    /// with the first axis fastest.
-    start: Vec<usize>,
-    point: Vec<u32>,
-    /// (x_p - x_e)/h of each entry.
-    offset: Vec<SVector<f64, D>>,
-    /// The weight w(x_e - x_p) of each entry, from which `apply` forms phi_p(x_e).
-    weight: Vec<f64>,
+    /// The most lattice points one particle reaches along an axis.
+    slots: usize,
+    /// Per particle of the last `fit`, the lattice points it reaches along each axis
+    /// (`tabulate`); its entries are their tensor product, from which `apply` forms
+    /// phi_p(x_e). Storing the axes, not the entries, keeps a particle's record to D of
+    /// them, from which each entry is one product of weights again.
+    reach: Vec<[usize; D]>,
+    /// Per particle, `D * slots` of each: the lattice index part, (x_p - x_e)/h along the
+    /// axis and the 1D weight factor, axis k's from slot `k * slots`.
+    axis_index: Vec<usize>,
+    axis_offset: Vec<f64>,
+    axis_factor: Vec<f64>,
     /// Per evaluation point, its moment matrix packed as `packed_len` describes, then its c_e.
     moments: Vec<f64>,
     /// Per evaluation point, the moments b_e = sum_p w q u_p of the velocities of the last
@@ -141,11 +143,11 @@ impl<const D: usize> Reconstructor<D> {
             recipe,
             terms,
             radius,
-            max_entries: per_axis.pow(D as u32),
-            start: Vec::new(),
-            point: Vec::new(),
-            offset: Vec::new(),
-            weight: Vec::new(),
+            slots: per_axis,
+            reach: Vec::new(),
+            axis_index: Vec::new(),
+            axis_offset: Vec::new(),
+            axis_factor: Vec::new(),
             moments: vec![0.0; points * packed_len(terms)],
             velocity_moments: Vec::new(),
             coeffs: vec![0.0; points * terms],
@@ -189,7 +191,7 @@ impl<const D: usize> Reconstructor<D> {
         out: &mut [SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
         // The entries of an earlier `fit` do not belong to this one.
-        self.start.clear();
+        self.reach.clear();
         match self.terms {
             1 => self.fit_apply_with::<1, 1>(x, v, out),
             2 => self.fit_apply_with::<2, { packed_len(2) }>(x, v, out),
@@ -213,19 +215,32 @@ impl<const D: usize> Reconstructor<D> {
         let b_of = self.velocity_moments.as_chunks_mut::<T>().0;
         let degree = degree_of::<T, D>();
         let mut q = [0.0; MAX_TERMS];
-        let visit = |p: usize, _, e: usize, w, d: &SVector<f64, D>| {
-            monomials(degree, d, &mut q);
-            add_moments::<T, P>(&mut a[e], w, &q);
-            add_velocity_moments::<T, D>(&mut b_of[e], w, &q, v[p]);
-        };
-        walk(
-            &self.lattice,
-            self.radius,
-            &self.recipe.kernel,
-            x,
-            visit,
-            |_, _| {},
-        );
+        let mut index = [[0usize; MAX_PER_AXIS]; D];
+        let mut offset = [[0.0f64; MAX_PER_AXIS]; D];
+        let mut factor = [[0.0f64; MAX_PER_AXIS]; D];
+        for (xp, &vp) in x.iter().zip(v) {
+            let tables = AxisTables {
+                slots: MAX_PER_AXIS,
+                reach: tabulate(
+                    &self.lattice,
+                    self.radius,
+                    &self.recipe.kernel,
+                    xp,
+                    MAX_PER_AXIS,
+                    index.as_flattened_mut(),
+                    offset.as_flattened_mut(),
+                    factor.as_flattened_mut(),
+                ),
+                index: index.as_flattened(),
+                offset: offset.as_flattened(),
+                factor: factor.as_flattened(),
+            };
+            tables.for_each_entry(|e, w, d| {
+                monomials(degree, d, &mut q);
+                add_moments::<T, P>(&mut a[e], w, &q);
+                add_velocity_moments::<T, D>(&mut b_of[e], w, &q, vp);
+            });
+        }
         let stats = self.solve::<T, P>()?;
         // u^h(x_e) = c_e . b_e, zero where no particle reaches.
         let b_of = self.velocity_moments.as_chunks::<T>().0;
@@ -251,41 +266,65 @@ impl<const D: usize> Reconstructor<D> {
         self.solve::<T, P>()
     }
 
-    /// Pass one: the lattice points each particle reaches, their weights and offsets, and
-    /// the moment matrices, summed particle by particle in order.
+    /// Pass one: the lattice points each particle reaches, axis by axis, and the moment
+    /// matrices, summed particle by particle in order.
     fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) {
-        // Sized for the most entries once; indexed writes are cheaper than pushes.
-        let capacity = x.len() * self.max_entries;
-        self.point.resize(capacity, 0);
-        self.offset.resize(capacity, SVector::zeros());
-        self.weight.resize(capacity, 0.0);
-        self.start.resize(x.len() + 1, 0);
+        let record = D * self.slots;
+        self.reach.resize(x.len(), [0; D]);
+        self.axis_index.resize(x.len() * record, 0);
+        self.axis_offset.resize(x.len() * record, 0.0);
+        self.axis_factor.resize(x.len() * record, 0.0);
         self.moments.fill(0.0);
         let a = self.moments.as_chunks_mut::<P>().0;
-        let (point, offset, weight, start) = (
-            &mut self.point,
-            &mut self.offset,
-            &mut self.weight,
-            &mut self.start,
-        );
         let degree = degree_of::<T, D>();
         let mut q = [0.0; MAX_TERMS];
-        let visit = |_, entry: usize, e: usize, w, d: &SVector<f64, D>| {
-            point[entry] = e as u32;
-            offset[entry] = *d;
-            weight[entry] = w;
-            monomials(degree, d, &mut q);
-            add_moments::<T, P>(&mut a[e], w, &q);
-        };
-        let particle_done = |p: usize, end| start[p + 1] = end;
-        walk(
-            &self.lattice,
-            self.radius,
-            &self.recipe.kernel,
-            x,
-            visit,
-            particle_done,
-        );
+        let records = self
+            .reach
+            .iter_mut()
+            .zip(self.axis_index.chunks_exact_mut(record))
+            .zip(self.axis_offset.chunks_exact_mut(record))
+            .zip(self.axis_factor.chunks_exact_mut(record));
+        for (xp, (((reach, index), offset), factor)) in x.iter().zip(records) {
+            *reach = tabulate(
+                &self.lattice,
+                self.radius,
+                &self.recipe.kernel,
+                xp,
+                self.slots,
+                index,
+                offset,
+                factor,
+            );
+            let tables = AxisTables {
+                slots: self.slots,
+                reach: *reach,
+                index,
+                offset,
+                factor,
+            };
+            tables.for_each_entry(|e, w, d| {
+                monomials(degree, d, &mut q);
+                add_moments::<T, P>(&mut a[e], w, &q);
+            });
+        }
+    }
+
+    /// The particles' tables of the last `fit`, in order.
+    fn tables(&self) -> impl Iterator<Item = AxisTables<'_, D>> {
+        let record = D * self.slots;
+        let records = self
+            .reach
+            .iter()
+            .zip(self.axis_index.chunks_exact(record))
+            .zip(self.axis_offset.chunks_exact(record))
+            .zip(self.axis_factor.chunks_exact(record));
+        records.map(|(((&reach, index), offset), factor)| AxisTables {
+            slots: self.slots,
+            reach,
+            index,
+            offset,
+            factor,
+        })
     }
 
     /// The coefficients c_e at every evaluation point.
@@ -345,100 +384,101 @@ impl<const D: usize> Reconstructor<D> {
     {
         out.fill(V::zero());
         assert!(
-            values.len() < self.start.len(),
+            values.len() <= self.reach.len(),
             "more values than particles in the last `fit`"
         );
         let degree = degree_of::<T, D>();
         let coeffs = self.coeffs.as_chunks::<T>().0;
         let mut q = [0.0; MAX_TERMS];
-        for (&value, ends) in values.iter().zip(self.start.windows(2)) {
-            let entries = ends[0]..ends[1];
-            let point = &self.point[entries.clone()];
-            let weight = &self.weight[entries.clone()];
-            let offset = &self.offset[entries];
-            for ((&e, &w), d) in point.iter().zip(weight).zip(offset) {
+        for (&value, tables) in values.iter().zip(self.tables()) {
+            tables.for_each_entry(|e, w, d| {
                 if w == 0.0 {
-                    continue;
+                    return;
                 }
                 monomials(degree, d, &mut q);
-                let c = &coeffs[e as usize];
+                let c = &coeffs[e];
                 let phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
                 if phi != 0.0 {
-                    out[e as usize] += value * phi;
+                    out[e] += value * phi;
                 }
-            }
+            });
         }
     }
 }
 
-/// Calls `visit(p, entry, e, w, d)` for every lattice point e each particle p reaches,
-/// in particle order and, per particle, the first axis fastest, with the entry's number
-/// counted from 0, the weight w(x_e - x_p) and the offset d = (x_p - x_e)/h; then
-/// `particle_done(p, entries so far)`. `radius` is the kernel's in cells.
+/// Tabulates, axis by axis, the lattice points within `radius` cells of `xp`: axis k's
+/// n-th in slot `k * slots + n` of `index` (its part of the lattice index), `offset`
+/// ((x_p - x_e)/h along the axis) and `factor` (the 1D weight). Returns their count per
+/// axis.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn walk<const D: usize>(
+fn tabulate<const D: usize>(
     lattice: &Lattice<D>,
     radius: f64,
     kernel: &Kernel,
-    x: &[SVector<f64, D>],
-    mut visit: impl FnMut(usize, usize, usize, f64, &SVector<f64, D>),
-    mut particle_done: impl FnMut(usize, usize),
-) {
-    let mut near = [(0usize, 0.0f64); MAX_PER_AXIS];
-    // Per axis and neighbour: the part of the lattice index, the offset and the 1D
-    // weight factor, so each entry only combines them.
-    let mut index = [[0usize; MAX_PER_AXIS]; D];
-    let mut axis_offset = [[0.0f64; MAX_PER_AXIS]; D];
-    let mut axis_weight = [[0.0f64; MAX_PER_AXIS]; D];
-    let mut count = [0usize; D];
+    xp: &SVector<f64, D>,
+    slots: usize,
+    index: &mut [usize],
+    offset: &mut [f64],
+    factor: &mut [f64],
+) -> [usize; D] {
     let inv_scale = 1.0 / kernel.scale;
     let weight = kernel.weight;
-    let mut entry = 0;
-    for (p, xp) in x.iter().enumerate() {
-        for k in 0..D {
-            count[k] = lattice.near_on_axis(k, xp[k], radius, &mut near);
-            for (j, &(i, dk)) in near[..count[k]].iter().enumerate() {
-                index[k][j] = i * lattice.stride(k);
-                axis_offset[k][j] = -dk;
-                axis_weight[k][j] = weight.eval(dk.abs() * inv_scale);
-            }
-        }
-        // In rows along the first axis: each row's index part and offsets of the other
-        // axes are taken once, and the weight is still the product w_0 w_1 ... in axis
-        // order.
-        let along = count[0];
-        let rows: usize = if along == 0 {
-            0
-        } else {
-            count[1..].iter().product()
+    let mut reach = [0; D];
+    for k in 0..D {
+        let stride = lattice.stride(k);
+        let index = &mut index[k * slots..][..slots];
+        let offset = &mut offset[k * slots..][..slots];
+        let factor = &mut factor[k * slots..][..slots];
+        reach[k] = lattice.near_on_axis(k, xp[k], radius, |j, i, dk| {
+            index[j] = i * stride;
+            offset[j] = -dk;
+            factor[j] = weight.eval(dk.abs() * inv_scale);
+        });
+    }
+    reach
+}
+
+/// One particle's lattice points along each axis, as `tabulate` leaves them; its entries
+/// are their tensor product.
+struct AxisTables<'a, const D: usize> {
+    slots: usize,
+    reach: [usize; D],
+    index: &'a [usize],
+    offset: &'a [f64],
+    factor: &'a [f64],
+}
+
+impl<const D: usize> AxisTables<'_, D> {
+    /// Calls `visit(e, w, d)` for every entry, the first axis fastest, with the lattice
+    /// point e, the weight w(x_e - x_p) = w_0 w_1 in axis order and the offset
+    /// d = (x_p - x_e)/h.
+    #[inline(always)]
+    fn for_each_entry(&self, mut visit: impl FnMut(usize, f64, &SVector<f64, D>)) {
+        const { assert!(D == 1 || D == 2, "the fits' bases are 1D and 2D") };
+        let axis = |k: usize| {
+            let (at, n) = (k * self.slots, self.reach[k]);
+            let tables = (&self.index[at..][..n], &self.offset[at..][..n]);
+            tables.0.iter().zip(tables.1).zip(&self.factor[at..][..n])
         };
-        let mut j = [0usize; D];
-        for _ in 0..rows {
-            let mut row_index = 0;
-            let mut d = SVector::<f64, D>::zeros();
-            for k in 1..D {
-                row_index += index[k][j[k]];
-                d[k] = axis_offset[k][j[k]];
+        let mut d = SVector::<f64, D>::zeros();
+        // A row along the first axis, its index part and the second axis's weight factor
+        // (none in 1D) taken once.
+        let mut row = |row_index: usize, factor_1: Option<f64>, d: &mut SVector<f64, D>| {
+            for ((&i, &d_0), &w_0) in axis(0) {
+                let w = factor_1.map_or(w_0, |w_1| w_0 * w_1);
+                d[0] = d_0;
+                visit(i + row_index, w, d);
             }
-            for i in 0..along {
-                let mut w = axis_weight[0][i];
-                for k in 1..D {
-                    w *= axis_weight[k][j[k]];
-                }
-                d[0] = axis_offset[0][i];
-                visit(p, entry, index[0][i] + row_index, w, &d);
-                entry += 1;
-            }
-            // The next row: an odometer over the axes after the first.
-            for k in 1..D {
-                j[k] += 1;
-                if j[k] < count[k] {
-                    break;
-                }
-                j[k] = 0;
+        };
+        if D == 1 {
+            row(0, None, &mut d);
+        } else {
+            for ((&row_index, &d_1), &w_1) in axis(1) {
+                d[1] = d_1;
+                row(row_index, Some(w_1), &mut d);
             }
         }
-        particle_done(p, entry);
     }
 }
 
