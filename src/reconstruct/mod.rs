@@ -37,7 +37,7 @@ pub use quadrature::{
     BodyForceFit, NodalVelocity, QuadratureRecipe, QuadratureTransfer, BODY_FORCE_FITS,
     BODY_FORCE_FIT_NAMES,
 };
-pub use shepard::{map_velocity, nodal_forces, particles_to_grid, remap_velocity};
+pub use shepard::{map_velocity, mass_and_forces, nodal_forces, particles_to_grid, remap_velocity};
 pub use solve::{moment_matrix, Moments, OrthogonalBasis, RANK_TOLERANCE};
 pub use taylor::{taylor_terms, Conservation, TaylorCell, TaylorFit, MAX_TAYLOR_TERMS};
 pub use taylor_transfer::{TaylorRecipe, TaylorTransfer};

@@ -30,10 +30,33 @@ pub fn particle_sums<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
+    sums::<D, true>(stencils, particles, body_force, grid);
+}
+
+/// The masses and forces of `particles_to_grid`, `grid.velocity` cleared: for transfers that
+/// make the nodal velocity another way (a fit of the particle velocities), which would
+/// discard the momenta.
+pub fn mass_and_forces<const D: usize>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    body_force: &[SVector<f64, D>],
+    grid: &mut GridState<D>,
+) {
+    sums::<D, false>(stencils, particles, body_force, grid);
+}
+
+/// Nodal masses and forces, and with `MOMENTUM` the momenta into `grid.velocity`; each sum's
+/// terms and order the same either way.
+fn sums<const D: usize, const MOMENTUM: bool>(
+    stencils: &Stencils<D>,
+    particles: &Particles<D>,
+    body_force: &[SVector<f64, D>],
+    grid: &mut GridState<D>,
+) {
     if stencils.has_value_entries() || stencils.dual_domain().is_some() {
-        // Mass and momentum over the entries with values, the forces over all of them (or in
-        // factored form).
-        lumped_sums(stencils, &particles.mass, &particles.v, grid);
+        // Mass (and momentum) over the entries with values, the forces over all of them (or
+        // in factored form).
+        lumped_sums::<D, MOMENTUM>(stencils, &particles.mass, &particles.v, grid);
         nodal_forces(stencils, particles, body_force, &mut grid.force);
         return;
     }
@@ -56,7 +79,9 @@ pub fn particle_sums<const D: usize>(
         point,
         |((mass, velocity), force), i, (m, mv, vs, mb), w, g| {
             mass[i] += m * w;
-            velocity[i] += mv * w;
+            if MOMENTUM {
+                velocity[i] += mv * w;
+            }
             force[i] += mb * w - vs * g;
         },
     );
@@ -71,13 +96,13 @@ pub fn map_velocity<const D: usize>(
     velocity: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
-    lumped_sums(stencils, mass, velocity, grid);
+    lumped_sums::<D, true>(stencils, mass, velocity, grid);
     momentum_to_velocity(&mut grid.velocity, &grid.mass, grid.empty_mass);
 }
 
-/// m_i = sum_p M_p N_ip and the momenta sum_p M_p u_p N_ip into `grid.velocity`, the rest of
-/// `grid` cleared.
-fn lumped_sums<const D: usize>(
+/// m_i = sum_p M_p N_ip and, with `MOMENTUM`, the momenta sum_p M_p u_p N_ip into
+/// `grid.velocity`, the rest of `grid` cleared.
+fn lumped_sums<const D: usize, const MOMENTUM: bool>(
     stencils: &Stencils<D>,
     mass: &[f64],
     velocity: &[SVector<f64, D>],
@@ -94,7 +119,9 @@ fn lumped_sums<const D: usize>(
         point,
         |(nodal_mass, momentum), i, (m, mu), w, _| {
             nodal_mass[i] += m * w;
-            momentum[i] += mu * w;
+            if MOMENTUM {
+                momentum[i] += mu * w;
+            }
         },
     );
 }

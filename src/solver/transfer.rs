@@ -8,8 +8,8 @@ use crate::integrate;
 use crate::particles::Particles;
 use crate::reconstruct::TransferKind;
 use crate::reconstruct::{
-    particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats, QuadratureTransfer,
-    TaylorTransfer, VelocityFit,
+    mass_and_forces, particles_to_grid, remap_velocity, ConsistentMassTransfer, FitStats,
+    QuadratureTransfer, TaylorTransfer, VelocityFit,
 };
 use crate::shape::{Shape, Stencils};
 
@@ -69,7 +69,7 @@ impl<const D: usize> Transfer<D> {
                 .map_to_grid(stencils, particles, body_force, grid)
                 .map_err(|e| Divergence::Reconstruction(e.to_string())),
             Transfer::FittedVelocity(fit) => {
-                particles_to_grid(stencils, particles, body_force, grid);
+                mass_and_forces(stencils, particles, body_force, grid);
                 let stats = fit
                     .map(&particles.x, &particles.v, &mut grid.velocity)
                     .map_err(|e| Divergence::Reconstruction(e.to_string()))?;
