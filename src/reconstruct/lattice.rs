@@ -17,7 +17,8 @@ pub struct Lattice<const D: usize> {
     /// Points per axis.
     per_axis: usize,
     /// Cells per axis that hold points, `per_axis / offsets.len()`: for the nodes one more
-    /// than the grid's, the upper face's node counting as a cell of its own.
+    /// than the grid's, the upper face's node counting as a cell of its own. Kept so that
+    /// `near_on_axis`, called per particle and axis, bounds its cells without a division.
     cells: usize,
     strides: [usize; D],
 }

@@ -30,7 +30,7 @@ pub fn particle_sums<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
-    sums::<D, true>(stencils, particles, body_force, grid);
+    mass_force_sums::<D, true>(stencils, particles, body_force, grid);
 }
 
 /// The masses and forces of `particles_to_grid`, `grid.velocity` cleared: for transfers that
@@ -42,12 +42,12 @@ pub fn mass_and_forces<const D: usize>(
     body_force: &[SVector<f64, D>],
     grid: &mut GridState<D>,
 ) {
-    sums::<D, false>(stencils, particles, body_force, grid);
+    mass_force_sums::<D, false>(stencils, particles, body_force, grid);
 }
 
 /// Nodal masses and forces, and with `MOMENTUM` the momenta into `grid.velocity`; each sum's
 /// terms and order the same either way.
-fn sums<const D: usize, const MOMENTUM: bool>(
+fn mass_force_sums<const D: usize, const MOMENTUM: bool>(
     stencils: &Stencils<D>,
     particles: &Particles<D>,
     body_force: &[SVector<f64, D>],
