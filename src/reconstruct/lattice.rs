@@ -79,7 +79,7 @@ impl<const D: usize> Lattice<D> {
     }
 
     /// Along `axis`, the lattice indices strictly within `radius` (in units of h) of `x`, in
-    /// index order: `found(n, i, d)` for the n-th of them, index i, offset d = (x_i - x)/h.
+    /// index order: `found(i, d)` for each, index i, offset d = (x_i - x)/h.
     /// Returns how many; at most `max_per_axis(radius)`. The callback lets a caller tabulate
     /// what it needs of each point as it is found, without a list in between.
     #[inline(always)]
@@ -88,7 +88,7 @@ impl<const D: usize> Lattice<D> {
         axis: usize,
         x: f64,
         radius: f64,
-        mut found: impl FnMut(usize, usize, f64),
+        mut found: impl FnMut(usize, f64),
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
@@ -110,7 +110,7 @@ impl<const D: usize> Lattice<D> {
                 return false;
             }
             if d > -radius {
-                found(n, i, d);
+                found(i, d);
                 n += 1;
             }
             true
@@ -210,14 +210,10 @@ mod tests {
         }
     }
 
-    /// `near_on_axis`'s points on the first axis, checking the slots and the bound on their
-    /// number.
+    /// `near_on_axis`'s points on the first axis, checking their count and its bound.
     fn near(lattice: &Lattice<1>, x: f64, radius: f64) -> Vec<(usize, f64)> {
         let mut out = Vec::new();
-        let n = lattice.near_on_axis(0, x, radius, |n, i, d| {
-            assert_eq!(n, out.len());
-            out.push((i, d));
-        });
+        let n = lattice.near_on_axis(0, x, radius, |i, d| out.push((i, d)));
         assert_eq!(n, out.len());
         assert!(n <= lattice.max_per_axis(radius));
         out

@@ -120,11 +120,13 @@ pub struct Reconstructor<const D: usize> {
     axis_index: Vec<usize>,
     axis_offset: Vec<f64>,
     axis_factor: Vec<f64>,
-    /// Per evaluation point, its moment matrix packed as `packed_len` describes, then its c_e.
-    moments: Vec<f64>,
-    /// Per evaluation point, the moments b_e = sum_p w q u_p of the velocities of the last
-    /// `fit_apply`, `terms` per point.
-    velocity_moments: Vec<SVector<f64, D>>,
+    /// The sums of the last fit, per pair of evaluation points (2m, 2m + 1): each of its
+    /// components for both points side by side. They are the moment matrix, packed as
+    /// `packed_len` describes, and after `fit_apply` the moments b_e = sum_p w q u_p of the
+    /// velocities, term k's component l at `packed_len + 2 k + l` (`sum_components`). A row
+    /// of a particle's entries reaches consecutive points, so two of its entries add to a
+    /// pair's sums at once.
+    pair_sums: Vec<[f64; 2]>,
     coeffs: Vec<f64>,
     covered: Vec<bool>,
 }
@@ -148,8 +150,7 @@ impl<const D: usize> Reconstructor<D> {
             axis_index: Vec::new(),
             axis_offset: Vec::new(),
             axis_factor: Vec::new(),
-            moments: vec![0.0; points * packed_len(terms)],
-            velocity_moments: Vec::new(),
+            pair_sums: Vec::new(),
             coeffs: vec![0.0; points * terms],
             covered: vec![false; points],
             lattice,
@@ -193,63 +194,71 @@ impl<const D: usize> Reconstructor<D> {
         // The entries of an earlier `fit` do not belong to this one.
         self.reach.clear();
         match self.terms {
-            1 => self.fit_apply_with::<1, 1>(x, v, out),
-            2 => self.fit_apply_with::<2, { packed_len(2) }>(x, v, out),
-            3 => self.fit_apply_with::<3, { packed_len(3) }>(x, v, out),
-            MAX_TERMS => self.fit_apply_with::<MAX_TERMS, { packed_len(MAX_TERMS) }>(x, v, out),
+            1 => self.fit_apply_with::<1, 1, { sum_components(1) }>(x, v, out),
+            2 => self.fit_apply_with::<2, { packed_len(2) }, { sum_components(2) }>(x, v, out),
+            3 => self.fit_apply_with::<3, { packed_len(3) }, { sum_components(3) }>(x, v, out),
+            MAX_TERMS => self.fit_apply_with::<
+                MAX_TERMS,
+                { packed_len(MAX_TERMS) },
+                { sum_components(MAX_TERMS) },
+            >(x, v, out),
             t => unreachable!("no basis has {t} terms"),
         }
     }
 
-    fn fit_apply_with<const T: usize, const P: usize>(
+    fn fit_apply_with<const T: usize, const P: usize, const S: usize>(
         &mut self,
         x: &[SVector<f64, D>],
         v: &[SVector<f64, D>],
         out: &mut [SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
-        self.moments.fill(0.0);
-        self.velocity_moments.clear();
-        self.velocity_moments
-            .resize(self.lattice.len() * T, SVector::zeros());
-        let a = self.moments.as_chunks_mut::<P>().0;
-        let b_of = self.velocity_moments.as_chunks_mut::<T>().0;
+        const { assert!(D <= 2 && S == sum_components(T) && P == packed_len(T)) };
+        let points = self.lattice.len();
+        self.pair_sums.clear();
+        self.pair_sums.resize(points.div_ceil(2) * S, [0.0; 2]);
+        let pairs = self.pair_sums.as_chunks_mut::<S>().0;
         let degree = degree_of::<T, D>();
-        let mut q = [0.0; MAX_TERMS];
-        let mut index = [[0usize; MAX_PER_AXIS]; D];
-        let mut offset = [[0.0f64; MAX_PER_AXIS]; D];
-        let mut factor = [[0.0f64; MAX_PER_AXIS]; D];
-        for (xp, &vp) in x.iter().zip(v) {
-            let tables = AxisTables {
-                slots: MAX_PER_AXIS,
-                reach: tabulate(
-                    &self.lattice,
-                    self.radius,
-                    &self.recipe.kernel,
-                    xp,
-                    MAX_PER_AXIS,
-                    index.as_flattened_mut(),
-                    offset.as_flattened_mut(),
-                    factor.as_flattened_mut(),
-                ),
-                index: index.as_flattened(),
-                offset: offset.as_flattened(),
-                factor: factor.as_flattened(),
-            };
-            tables.for_each_entry(|e, w, d| {
-                monomials(degree, d, &mut q);
-                add_moments::<T, P>(&mut a[e], w, &q);
-                add_velocity_moments::<T, D>(&mut b_of[e], w, &q, vp);
+        let search = Search {
+            lattice: &self.lattice,
+            radius: self.radius,
+            kernel: &self.recipe.kernel,
+        };
+        let mut tables = [PointTables::<D>::new(), PointTables::new()];
+        let (x_pairs, x_rest) = x.as_chunks::<2>();
+        let (v_pairs, v_rest) = v.as_chunks::<2>();
+        for (xp, vp) in x_pairs.iter().zip(v_pairs) {
+            let [a, b] = &mut tables;
+            let (a, b) = (a.record(), b.record());
+            let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
+            add_particle_pair::<T, P, S, D, true>(pairs, tables, degree, *vp);
+        }
+        for (xp, &vp) in x_rest.iter().zip(v_rest) {
+            let a = tables[0].record().tabulate(&search, xp);
+            for_each_row([&a], |rows| {
+                add_rows::<T, P, S, D, 1, true>(pairs, rows, degree, [vp])
             });
         }
-        let stats = self.solve::<T, P>()?;
+        let pairs = self.pair_sums.as_chunks::<S>().0;
+        let sums = |e: usize| (&pairs[e / 2], e % 2);
+        let stats = solve_points::<T, P, D>(
+            &self.recipe,
+            &self.lattice,
+            |e| {
+                let (sums, lane) = sums(e);
+                std::array::from_fn(|c| sums[c][lane])
+            },
+            &mut self.coeffs,
+            &mut self.covered,
+        )?;
         // u^h(x_e) = c_e . b_e, zero where no particle reaches.
-        let b_of = self.velocity_moments.as_chunks::<T>().0;
         let coeffs = self.coeffs.as_chunks::<T>().0;
-        for (e, ((u, b), c)) in out.iter_mut().zip(b_of).zip(coeffs).enumerate() {
+        for (e, (u, c)) in out.iter_mut().zip(coeffs).enumerate() {
             *u = SVector::zeros();
             if self.covered[e] {
+                let (sums, lane) = sums(e);
                 for k in 0..T {
-                    *u += b[k] * c[k];
+                    let b_k = SVector::<f64, D>::from_fn(|l, _| sums[P + 2 * k + l][lane]);
+                    *u += b_k * c[k];
                 }
             }
         }
@@ -263,7 +272,14 @@ impl<const D: usize> Reconstructor<D> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
         debug_assert_eq!(P, packed_len(T));
         self.gather_weights::<T, P>(x);
-        self.solve::<T, P>()
+        let pairs = self.pair_sums.as_chunks::<P>().0;
+        solve_points::<T, P, D>(
+            &self.recipe,
+            &self.lattice,
+            |e| std::array::from_fn(|c| pairs[e / 2][c][e % 2]),
+            &mut self.coeffs,
+            &mut self.covered,
+        )
     }
 
     /// Pass one: the lattice points each particle reaches, axis by axis, and the moment
@@ -274,37 +290,42 @@ impl<const D: usize> Reconstructor<D> {
         self.axis_index.resize(x.len() * record, 0);
         self.axis_offset.resize(x.len() * record, 0.0);
         self.axis_factor.resize(x.len() * record, 0.0);
-        self.moments.fill(0.0);
-        let a = self.moments.as_chunks_mut::<P>().0;
+        self.pair_sums.clear();
+        self.pair_sums
+            .resize(self.lattice.len().div_ceil(2) * P, [0.0; 2]);
+        let pairs = self.pair_sums.as_chunks_mut::<P>().0;
         let degree = degree_of::<T, D>();
-        let mut q = [0.0; MAX_TERMS];
-        let records = self
+        let search = Search {
+            lattice: &self.lattice,
+            radius: self.radius,
+            kernel: &self.recipe.kernel,
+        };
+        let slots = self.slots;
+        let mut records = self
             .reach
             .iter_mut()
             .zip(self.axis_index.chunks_exact_mut(record))
             .zip(self.axis_offset.chunks_exact_mut(record))
-            .zip(self.axis_factor.chunks_exact_mut(record));
-        for (xp, (((reach, index), offset), factor)) in x.iter().zip(records) {
-            *reach = tabulate(
-                &self.lattice,
-                self.radius,
-                &self.recipe.kernel,
-                xp,
-                self.slots,
+            .zip(self.axis_factor.chunks_exact_mut(record))
+            .map(|(((reach, index), offset), factor)| Record {
+                slots,
+                reach,
                 index,
                 offset,
                 factor,
-            );
-            let tables = AxisTables {
-                slots: self.slots,
-                reach: *reach,
-                index,
-                offset,
-                factor,
-            };
-            tables.for_each_entry(|e, w, d| {
-                monomials(degree, d, &mut q);
-                add_moments::<T, P>(&mut a[e], w, &q);
+            });
+        let (x_pairs, x_rest) = x.as_chunks::<2>();
+        for xp in x_pairs {
+            let (a, b) = (records.next(), records.next());
+            let (a, b) = (a.expect("a record"), b.expect("a record"));
+            let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
+            add_particle_pair::<T, P, P, D, false>(pairs, tables, degree, [SVector::zeros(); 2]);
+        }
+        for xp in x_rest {
+            let a = records.next().expect("a record").tabulate(&search, xp);
+            let u = [SVector::zeros()];
+            for_each_row([&a], |rows| {
+                add_rows::<T, P, P, D, 1, false>(pairs, rows, degree, u)
             });
         }
     }
@@ -325,41 +346,6 @@ impl<const D: usize> Reconstructor<D> {
             offset,
             factor,
         })
-    }
-
-    /// The coefficients c_e at every evaluation point.
-    fn solve<const T: usize, const P: usize>(&mut self) -> Result<FitStats, SingularMoments> {
-        let mut stats = FitStats::default();
-        let packed = self.moments.as_chunks::<P>().0;
-        for (e, packed) in packed.iter().enumerate() {
-            let a = unpack::<T, P>(packed);
-            let a = &a[..];
-            let c = &mut self.coeffs[e * T..][..T];
-            self.covered[e] = a[0] > 0.0;
-            if !self.covered[e] {
-                c.fill(0.0);
-                continue;
-            }
-            stats.fits += 1;
-            match self.recipe.solver {
-                Solver::Mls => {
-                    let solved =
-                        mls_coefficients::<T>(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
-                            point: e,
-                            position: self.lattice.point(e).iter().copied().collect(),
-                        })?;
-                    c.copy_from_slice(&solved[..T]);
-                }
-                Solver::Imls => {
-                    let basis = Orthogonal::<T>::from_rows(a, MAX_TERMS, T);
-                    if basis.rank() < T {
-                        stats.rank_deficient += 1;
-                    }
-                    c.copy_from_slice(&basis.shape_coefficients::<T>());
-                }
-            }
-        }
-        Ok(stats)
     }
 
     /// u^h at every evaluation point from particle values `values` (same order as the fit),
@@ -389,27 +375,113 @@ impl<const D: usize> Reconstructor<D> {
         );
         let degree = degree_of::<T, D>();
         let coeffs = self.coeffs.as_chunks::<T>().0;
-        let mut q = [0.0; MAX_TERMS];
-        for (&value, tables) in values.iter().zip(self.tables()) {
-            tables.for_each_entry(|e, w, d| {
-                if w == 0.0 {
-                    return;
-                }
-                monomials(degree, d, &mut q);
-                let c = &coeffs[e];
-                let phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
-                if phi != 0.0 {
-                    out[e] += value * phi;
-                }
+        // Two particles at a time, as the fit summed them: where they reach the same points,
+        // each point's value is loaded and stored once for both.
+        let mut tables = self.tables();
+        let (pairs, rest) = values.as_chunks::<2>();
+        for &[value_a, value_b] in pairs {
+            let (a, b) = (tables.next(), tables.next());
+            let (a, b) = (a.expect("a fit entry"), b.expect("a fit entry"));
+            if a.same_points(&b) {
+                for_each_row([&a, &b], |rows| {
+                    apply_rows::<T, D, V, 2>(rows, [value_a, value_b], coeffs, degree, out);
+                });
+            } else {
+                for_each_row([&a], |rows| {
+                    apply_rows::<T, D, V, 1>(rows, [value_a], coeffs, degree, out);
+                });
+                for_each_row([&b], |rows| {
+                    apply_rows::<T, D, V, 1>(rows, [value_b], coeffs, degree, out);
+                });
+            }
+        }
+        for (&value, tables) in rest.iter().zip(tables) {
+            for_each_row([&tables], |rows| {
+                apply_rows::<T, D, V, 1>(rows, [value], coeffs, degree, out);
             });
         }
     }
 }
 
-/// Tabulates, axis by axis, the lattice points within `radius` cells of `xp`: axis k's
-/// n-th in slot `k * slots + n` of `index` (its part of the lattice index), `offset`
-/// ((x_p - x_e)/h along the axis) and `factor` (the 1D weight). Returns their count per
-/// axis.
+/// u^h += sum_p phi_p(x_e) u_p over the rows `rows` of `M` particles that reach the same
+/// points, with their values `values`: per point, particle by particle, each entry's shape
+/// function phi_p(x_e) = w q((x_p - x_e)/h) . c_e taken as it is used.
+#[inline(always)]
+fn apply_rows<const T: usize, const D: usize, V, const M: usize>(
+    rows: &[Row<'_, D>; M],
+    values: [V; M],
+    coeffs: &[[f64; T]],
+    degree: Degree,
+    out: &mut [V],
+) where
+    V: Copy + AddAssign + Mul<f64, Output = V>,
+{
+    let first = rows[0].first;
+    let n = rows[0].factor.len();
+    let (coeffs, out) = (&coeffs[first..][..n], &mut out[first..][..n]);
+    let mut q = [0.0; MAX_TERMS];
+    for (j, (c, out)) in coeffs.iter().zip(out).enumerate() {
+        for (row, &value) in rows.iter().zip(&values) {
+            let w_0 = row.factor[j];
+            let w = row.factor_1.map_or(w_0, |w_1| w_0 * w_1);
+            let mut d = row.across;
+            d[0] = row.offset[j];
+            monomials(degree, &d, &mut q);
+            let phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
+            if phi != 0.0 {
+                *out += value * phi;
+            }
+        }
+    }
+}
+
+/// The coefficients c_e at every evaluation point of `lattice`, from its packed moment
+/// matrix `moments(e)`; whether a particle reached it in `covered`.
+fn solve_points<const T: usize, const P: usize, const D: usize>(
+    recipe: &Recipe,
+    lattice: &Lattice<D>,
+    moments: impl Fn(usize) -> [f64; P],
+    coeffs: &mut [f64],
+    covered: &mut [bool],
+) -> Result<FitStats, SingularMoments> {
+    let mut stats = FitStats::default();
+    let coeffs = coeffs.as_chunks_mut::<T>().0;
+    for (e, (c, covered)) in coeffs.iter_mut().zip(covered.iter_mut()).enumerate() {
+        let a = unpack::<T, P>(&moments(e));
+        let a = &a[..];
+        *covered = a[0] > 0.0;
+        if !*covered {
+            c.fill(0.0);
+            continue;
+        }
+        stats.fits += 1;
+        match recipe.solver {
+            Solver::Mls => {
+                let solved =
+                    mls_coefficients::<T>(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
+                        point: e,
+                        position: lattice.point(e).iter().copied().collect(),
+                    })?;
+                c.copy_from_slice(&solved[..T]);
+            }
+            Solver::Imls => {
+                let basis = Orthogonal::<T>::from_rows(a, MAX_TERMS, T);
+                if basis.rank() < T {
+                    stats.rank_deficient += 1;
+                }
+                c.copy_from_slice(&basis.shape_coefficients::<T>());
+            }
+        }
+    }
+    Ok(stats)
+}
+
+/// Tabulates, axis by axis, the lattice points within `radius` cells of `xp` whose 1D weight
+/// is positive: axis k's n-th in slot `k * slots + n` of `index` (its part of the lattice
+/// index), `offset` ((x_p - x_e)/h along the axis) and `factor` (the weight). Returns their
+/// count per axis. A point left out lies at the edge of the support (|d| / scale rounded
+/// to the weight's radius) and adds nothing to any sum; so every entry's weight, a product
+/// of factors no smaller than about 1e-48, is positive, and the sums need no test for zero.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn tabulate<const D: usize>(
@@ -430,13 +502,89 @@ fn tabulate<const D: usize>(
         let index = &mut index[k * slots..][..slots];
         let offset = &mut offset[k * slots..][..slots];
         let factor = &mut factor[k * slots..][..slots];
-        reach[k] = lattice.near_on_axis(k, xp[k], radius, |j, i, dk| {
-            index[j] = i * stride;
-            offset[j] = -dk;
-            factor[j] = weight.eval(dk.abs() * inv_scale);
+        let mut n = 0;
+        lattice.near_on_axis(k, xp[k], radius, |i, dk| {
+            let w = weight.eval(dk.abs() * inv_scale);
+            if w > 0.0 {
+                index[n] = i * stride;
+                offset[n] = -dk;
+                factor[n] = w;
+                n += 1;
+            }
         });
+        reach[k] = n;
     }
     reach
+}
+
+/// Room for one particle's `AxisTables`, for a fit that does not keep them (`fit_apply`).
+struct PointTables<const D: usize> {
+    reach: [usize; D],
+    index: [[usize; MAX_PER_AXIS]; D],
+    offset: [[f64; MAX_PER_AXIS]; D],
+    factor: [[f64; MAX_PER_AXIS]; D],
+}
+
+impl<const D: usize> PointTables<D> {
+    fn new() -> Self {
+        PointTables {
+            reach: [0; D],
+            index: [[0; MAX_PER_AXIS]; D],
+            offset: [[0.0; MAX_PER_AXIS]; D],
+            factor: [[0.0; MAX_PER_AXIS]; D],
+        }
+    }
+
+    /// Its room, as a `Record` to fill.
+    fn record(&mut self) -> Record<'_, D> {
+        Record {
+            slots: MAX_PER_AXIS,
+            reach: &mut self.reach,
+            index: self.index.as_flattened_mut(),
+            offset: self.offset.as_flattened_mut(),
+            factor: self.factor.as_flattened_mut(),
+        }
+    }
+}
+
+/// Where `tabulate` searches: the lattice, the radius in cells and the kernel.
+struct Search<'a, const D: usize> {
+    lattice: &'a Lattice<D>,
+    radius: f64,
+    kernel: &'a Kernel,
+}
+
+/// Room for one particle's `AxisTables`, `slots` per axis.
+struct Record<'a, const D: usize> {
+    slots: usize,
+    reach: &'a mut [usize; D],
+    index: &'a mut [usize],
+    offset: &'a mut [f64],
+    factor: &'a mut [f64],
+}
+
+impl<'a, const D: usize> Record<'a, D> {
+    /// Fills the record for a particle at `xp` (`tabulate`) and reads it as its tables.
+    #[inline(always)]
+    fn tabulate(self, search: &Search<'_, D>, xp: &SVector<f64, D>) -> AxisTables<'a, D> {
+        *self.reach = tabulate(
+            search.lattice,
+            search.radius,
+            search.kernel,
+            xp,
+            self.slots,
+            self.index,
+            self.offset,
+            self.factor,
+        );
+        AxisTables {
+            slots: self.slots,
+            reach: *self.reach,
+            index: self.index,
+            offset: self.offset,
+            factor: self.factor,
+        }
+    }
 }
 
 /// One particle's lattice points along each axis, as `tabulate` leaves them; its entries
@@ -450,36 +598,73 @@ struct AxisTables<'a, const D: usize> {
 }
 
 impl<const D: usize> AxisTables<'_, D> {
-    /// Calls `visit(e, w, d)` for every entry, the first axis fastest, with the lattice
-    /// point e, the weight w(x_e - x_p) = w_0 w_1 in axis order and the offset
-    /// d = (x_p - x_e)/h.
+    /// Whether `other` reaches the same lattice points: then their entries' rows are the
+    /// same, each with its own weights and offsets.
     #[inline(always)]
-    fn for_each_entry(&self, mut visit: impl FnMut(usize, f64, &SVector<f64, D>)) {
-        const { assert!(D == 1 || D == 2, "the fits' bases are 1D and 2D") };
-        let axis = |k: usize| {
-            let (at, n) = (k * self.slots, self.reach[k]);
-            let tables = (&self.index[at..][..n], &self.offset[at..][..n]);
-            tables.0.iter().zip(tables.1).zip(&self.factor[at..][..n])
-        };
-        let mut d = SVector::<f64, D>::zeros();
-        // A row along the first axis, its index part and the second axis's weight factor
-        // (none in 1D) taken once.
-        let mut row = |row_index: usize, factor_1: Option<f64>, d: &mut SVector<f64, D>| {
-            for ((&i, &d_0), &w_0) in axis(0) {
-                let w = factor_1.map_or(w_0, |w_1| w_0 * w_1);
-                d[0] = d_0;
-                visit(i + row_index, w, d);
-            }
-        };
-        if D == 1 {
-            row(0, None, &mut d);
-        } else {
-            for ((&row_index, &d_1), &w_1) in axis(1) {
-                d[1] = d_1;
-                row(row_index, Some(w_1), &mut d);
-            }
-        }
+    fn same_points(&self, other: &Self) -> bool {
+        (0..D).all(|k| {
+            let n = self.reach[k];
+            n == other.reach[k]
+                && (n == 0 || self.index[k * self.slots] == other.index[k * other.slots])
+        })
     }
+}
+
+/// Calls `visit` for every row of entries along the first axis of `M` particles that reach
+/// the same points (`AxisTables::same_points`), the rows in the order of `for_each_entry`,
+/// with each particle's row. A row's lattice points are consecutive: the first axis's points
+/// in reach are a run of indices, of stride 1.
+#[inline(always)]
+fn for_each_row<const D: usize, const M: usize>(
+    tables: [&AxisTables<'_, D>; M],
+    mut visit: impl FnMut(&[Row<'_, D>; M]),
+) {
+    const { assert!(D == 1 || D == 2, "the fits' bases are 1D and 2D") };
+    let lead = tables[0];
+    debug_assert!(tables.iter().all(|t| t.same_points(lead)));
+    let n = lead.reach[0];
+    if n == 0 {
+        return;
+    }
+    debug_assert!(lead.index[..n]
+        .windows(2)
+        .all(|pair| pair[1] == pair[0] + 1));
+    let first = lead.index[0];
+    if D == 1 {
+        visit(&tables.map(|t| Row {
+            first,
+            offset: &t.offset[..n],
+            factor: &t.factor[..n],
+            factor_1: None,
+            across: SVector::zeros(),
+        }));
+        return;
+    }
+    for r in 0..lead.reach[1] {
+        let row_index = lead.index[lead.slots + r];
+        visit(&tables.map(|t| {
+            let mut across = SVector::zeros();
+            across[D - 1] = t.offset[t.slots + r];
+            Row {
+                first: row_index + first,
+                offset: &t.offset[..n],
+                factor: &t.factor[..n],
+                factor_1: Some(t.factor[t.slots + r]),
+                across,
+            }
+        }));
+    }
+}
+
+/// One row of a particle's entries along the first axis: lattice points `first`,
+/// `first + 1`, ..., with the first axis's offsets and weight factors, the other axis's
+/// factor (none in 1D) and its offset in `across` (whose first component is unused).
+struct Row<'a, const D: usize> {
+    first: usize,
+    offset: &'a [f64],
+    factor: &'a [f64],
+    factor_1: Option<f64>,
+    across: SVector<f64, D>,
 }
 
 /// The least-squares fit of the particle velocities at the grid nodes, refitted every step.
@@ -533,34 +718,147 @@ const fn packed_len(terms: usize) -> usize {
     terms + (terms - 1) * (terms - 1)
 }
 
-/// a += w q q^T, packed.
+/// Components of `fit_apply`'s sums per point: the packed moment matrix and the velocity
+/// moments, two per term (the second unused in 1D).
+const fn sum_components(terms: usize) -> usize {
+    packed_len(terms) + 2 * terms
+}
+
+/// Adds two consecutive particles' entries (`add_rows`), with their velocities for a
+/// `fit_apply`: together where they reach the same points (neighbours in a cell), so that
+/// each point's sums are loaded and stored once for both; else one after the other.
 #[inline(always)]
-fn add_moments<const T: usize, const P: usize>(a: &mut [f64; P], w: f64, q: &[f64; MAX_TERMS]) {
-    debug_assert_eq!(q[0], 1.0);
-    let wq: [f64; T] = std::array::from_fn(|r| w * q[r]);
+fn add_particle_pair<
+    const T: usize,
+    const P: usize,
+    const S: usize,
+    const D: usize,
+    const VELOCITY: bool,
+>(
+    pairs: &mut [[[f64; 2]; S]],
+    (a, b): (AxisTables<'_, D>, AxisTables<'_, D>),
+    degree: Degree,
+    u: [SVector<f64, D>; 2],
+) {
+    if a.same_points(&b) {
+        for_each_row([&a, &b], |rows| {
+            add_rows::<T, P, S, D, 2, VELOCITY>(pairs, rows, degree, u);
+        });
+    } else {
+        for_each_row([&a], |rows| {
+            add_rows::<T, P, S, D, 1, VELOCITY>(pairs, rows, degree, [u[0]]);
+        });
+        for_each_row([&b], |rows| {
+            add_rows::<T, P, S, D, 1, VELOCITY>(pairs, rows, degree, [u[1]]);
+        });
+    }
+}
+
+/// Adds the entries of the rows of `M` particles that reach the same points (their rows
+/// `rows`, their velocities `u`) to `pairs` (`Reconstructor::pair_sums`): a += w q q^T and
+/// b += u (w q) each, two entries at a time where they share a pair of points, and each
+/// point's sums loaded and stored once for the M particles. Each entry of a particle lands
+/// on its own point and the particles are added in order, so the sums of every point run in
+/// particle order, as they would one entry at a time.
+#[inline(always)]
+fn add_rows<
+    const T: usize,
+    const P: usize,
+    const S: usize,
+    const D: usize,
+    const M: usize,
+    const VELOCITY: bool,
+>(
+    pairs: &mut [[[f64; 2]; S]],
+    rows: &[Row<'_, D>; M],
+    degree: Degree,
+    u: [SVector<f64, D>; M],
+) {
+    let n = rows[0].factor.len();
+    let (mut j, mut e) = (0, rows[0].first);
+    if e % 2 == 1 {
+        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut pairs[e / 2], 1, j, rows, degree, u);
+        (j, e) = (1, e + 1);
+    }
+    while j + 2 <= n {
+        add_entries::<T, P, S, D, 2, M, VELOCITY>(&mut pairs[e / 2], 0, j, rows, degree, u);
+        (j, e) = (j + 2, e + 2);
+    }
+    if j < n {
+        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut pairs[e / 2], 0, j, rows, degree, u);
+    }
+}
+
+/// `L` consecutive entries of the `M` particles' rows from their `j`-th, on lanes
+/// `lane..lane + L` of one pair of points: a += w q q^T (packed) and b += u (w q), term by
+/// term, particle by particle.
+#[inline(always)]
+fn add_entries<
+    const T: usize,
+    const P: usize,
+    const S: usize,
+    const D: usize,
+    const L: usize,
+    const M: usize,
+    const VELOCITY: bool,
+>(
+    sums: &mut [[f64; 2]; S],
+    lane: usize,
+    j: usize,
+    rows: &[Row<'_, D>; M],
+    degree: Degree,
+    u: [SVector<f64, D>; M],
+) {
+    let w: [[f64; L]; M] = std::array::from_fn(|m| {
+        std::array::from_fn(|l| {
+            let w_0 = rows[m].factor[j + l];
+            rows[m].factor_1.map_or(w_0, |w_1| w_0 * w_1)
+        })
+    });
+    let q: [[[f64; MAX_TERMS]; L]; M] = std::array::from_fn(|m| {
+        std::array::from_fn(|l| {
+            let mut d = rows[m].across;
+            d[0] = rows[m].offset[j + l];
+            let mut q = [0.0; MAX_TERMS];
+            monomials(degree, &d, &mut q);
+            q
+        })
+    });
+    let wq: [[[f64; T]; L]; M] = std::array::from_fn(|m| {
+        std::array::from_fn(|l| std::array::from_fn(|r| w[m][l] * q[m][l][r]))
+    });
     for s in 0..T {
-        a[s] += wq[0] * q[s];
+        add_terms::<L, M>(&mut sums[s], lane, |m, l| wq[m][l][0] * q[m][l][s]);
     }
     for r in 1..T {
         for s in 1..T {
-            a[T + (r - 1) * (T - 1) + s - 1] += wq[r] * q[s];
+            let c = T + (r - 1) * (T - 1) + s - 1;
+            add_terms::<L, M>(&mut sums[c], lane, |m, l| wq[m][l][r] * q[m][l][s]);
+        }
+    }
+    if !VELOCITY {
+        return;
+    }
+    for k in 0..T {
+        for c in 0..D {
+            let b = &mut sums[P + 2 * k + c];
+            add_terms::<L, M>(b, lane, |m, l| u[m][c] * (w[m][l] * q[m][l][k]));
         }
     }
 }
 
-/// b += u (w q), term by term; an entry of zero weight adds nothing, whatever u holds.
+/// One component's sums on lanes `lane..lane + L`: each adds `term(m, l)` for particle m in
+/// order.
 #[inline(always)]
-fn add_velocity_moments<const T: usize, const D: usize>(
-    b: &mut [SVector<f64, D>; T],
-    w: f64,
-    q: &[f64; MAX_TERMS],
-    u: SVector<f64, D>,
+fn add_terms<const L: usize, const M: usize>(
+    sums: &mut [f64; 2],
+    lane: usize,
+    term: impl Fn(usize, usize) -> f64,
 ) {
-    if w == 0.0 {
-        return;
-    }
-    for k in 0..T {
-        b[k] += u * (w * q[k]);
+    for l in 0..L {
+        for m in 0..M {
+            sums[lane + l] += term(m, l);
+        }
     }
 }
 
