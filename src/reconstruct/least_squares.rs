@@ -20,7 +20,7 @@ use nalgebra::SVector;
 use num_traits::Zero;
 
 use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
-use super::kernel::Kernel;
+use super::kernel::{Kernel, Weight};
 use super::lattice::Lattice;
 use super::solve::{mls_coefficients, Moments, Orthogonal};
 use crate::grid::Grid;
@@ -476,26 +476,42 @@ fn solve_points<const T: usize, const P: usize, const D: usize>(
     Ok(stats)
 }
 
-/// Tabulates, axis by axis, the lattice points within `radius` cells of `xp` whose 1D weight
-/// is positive: axis k's n-th in slot `k * slots + n` of `index` (its part of the lattice
-/// index), `offset` ((x_p - x_e)/h along the axis) and `factor` (the weight). Returns their
-/// count per axis. A point left out lies at the edge of the support (|d| / scale rounded
-/// to the weight's radius) and adds nothing to any sum; so every entry's weight, a product
-/// of factors no smaller than about 1e-48, is positive, and the sums need no test for zero.
-#[allow(clippy::too_many_arguments)]
+/// Tabulates, axis by axis, the lattice points within `search.radius` cells of `xp` whose
+/// 1D weight is positive: axis k's n-th in slot `k * slots + n` of `index` (its part of the
+/// lattice index), `offset` ((x_p - x_e)/h along the axis) and `factor` (the weight). Returns
+/// their count per axis. A point left out lies at the edge of the support (|d| / scale
+/// rounded to the weight's radius) and adds nothing to any sum; so every entry's weight, a
+/// product of factors no smaller than about 1e-48, is positive, and the sums need no test
+/// for zero.
 #[inline(always)]
 fn tabulate<const D: usize>(
-    lattice: &Lattice<D>,
-    radius: f64,
-    kernel: &Kernel,
+    search: &Search<'_, D>,
     xp: &SVector<f64, D>,
     slots: usize,
     index: &mut [usize],
     offset: &mut [f64],
     factor: &mut [f64],
 ) -> [usize; D] {
-    let inv_scale = 1.0 / kernel.scale;
-    let weight = kernel.weight;
+    // The weight's kind is taken once a particle, not at each point it reaches.
+    let tables = (slots, index, offset, factor);
+    match search.kernel.weight {
+        Weight::Hat => tabulate_with(search, xp, tables, |r| Weight::Hat.eval(r)),
+        Weight::QuadraticSpline => {
+            tabulate_with(search, xp, tables, |r| Weight::QuadraticSpline.eval(r))
+        }
+        Weight::CubicSpline => tabulate_with(search, xp, tables, |r| Weight::CubicSpline.eval(r)),
+    }
+}
+
+/// `tabulate` with the weight w(r) `eval`.
+#[inline(always)]
+fn tabulate_with<const D: usize>(
+    search: &Search<'_, D>,
+    xp: &SVector<f64, D>,
+    (slots, index, offset, factor): (usize, &mut [usize], &mut [f64], &mut [f64]),
+    eval: impl Fn(f64) -> f64,
+) -> [usize; D] {
+    let (lattice, radius, inv_scale) = (search.lattice, search.radius, 1.0 / search.kernel.scale);
     let mut reach = [0; D];
     for k in 0..D {
         let stride = lattice.stride(k);
@@ -504,7 +520,7 @@ fn tabulate<const D: usize>(
         let factor = &mut factor[k * slots..][..slots];
         let mut n = 0;
         lattice.near_on_axis(k, xp[k], radius, |i, dk| {
-            let w = weight.eval(dk.abs() * inv_scale);
+            let w = eval(dk.abs() * inv_scale);
             if w > 0.0 {
                 index[n] = i * stride;
                 offset[n] = -dk;
@@ -567,16 +583,7 @@ impl<'a, const D: usize> Record<'a, D> {
     /// Fills the record for a particle at `xp` (`tabulate`) and reads it as its tables.
     #[inline(always)]
     fn tabulate(self, search: &Search<'_, D>, xp: &SVector<f64, D>) -> AxisTables<'a, D> {
-        *self.reach = tabulate(
-            search.lattice,
-            search.radius,
-            search.kernel,
-            xp,
-            self.slots,
-            self.index,
-            self.offset,
-            self.factor,
-        );
+        *self.reach = tabulate(search, xp, self.slots, self.index, self.offset, self.factor);
         AxisTables {
             slots: self.slots,
             reach: *self.reach,
