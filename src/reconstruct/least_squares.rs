@@ -218,11 +218,7 @@ impl<const D: usize> Reconstructor<D> {
         self.pair_sums.resize(points.div_ceil(2) * S, [0.0; 2]);
         let pairs = self.pair_sums.as_chunks_mut::<S>().0;
         let degree = degree_of::<T, D>();
-        let search = Search {
-            lattice: &self.lattice,
-            radius: self.radius,
-            kernel: &self.recipe.kernel,
-        };
+        let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let mut tables = [PointTables::<D>::new(), PointTables::new()];
         let (x_pairs, x_rest) = x.as_chunks::<2>();
         let (v_pairs, v_rest) = v.as_chunks::<2>();
@@ -295,11 +291,7 @@ impl<const D: usize> Reconstructor<D> {
             .resize(self.lattice.len().div_ceil(2) * P, [0.0; 2]);
         let pairs = self.pair_sums.as_chunks_mut::<P>().0;
         let degree = degree_of::<T, D>();
-        let search = Search {
-            lattice: &self.lattice,
-            radius: self.radius,
-            kernel: &self.recipe.kernel,
-        };
+        let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let slots = self.slots;
         let mut records = self
             .reach
@@ -563,11 +555,21 @@ impl<const D: usize> PointTables<D> {
     }
 }
 
-/// Where `tabulate` searches: the lattice, the radius in cells and the kernel.
+/// Where `tabulate` searches: the lattice, the kernel's support radius in cells and the kernel.
 struct Search<'a, const D: usize> {
     lattice: &'a Lattice<D>,
     radius: f64,
     kernel: &'a Kernel,
+}
+
+impl<'a, const D: usize> Search<'a, D> {
+    fn new(lattice: &'a Lattice<D>, radius: f64, kernel: &'a Kernel) -> Self {
+        Search {
+            lattice,
+            radius,
+            kernel,
+        }
+    }
 }
 
 /// Room for one particle's `AxisTables`, `slots` per axis.
@@ -618,8 +620,8 @@ impl<const D: usize> AxisTables<'_, D> {
 }
 
 /// Calls `visit` for every row of entries along the first axis of `M` particles that reach
-/// the same points (`AxisTables::same_points`), the rows in the order of `for_each_entry`,
-/// with each particle's row. A row's lattice points are consecutive: the first axis's points
+/// the same points (`AxisTables::same_points`), in the order of the second axis's points
+/// (one row in 1D), with each particle's row. A row's lattice points are consecutive: the first axis's points
 /// in reach are a run of indices, of stride 1.
 #[inline(always)]
 fn for_each_row<const D: usize, const M: usize>(
