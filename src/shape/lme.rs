@@ -46,9 +46,6 @@ const MAX_SIDE_2D: usize = 32;
 /// From a warm start the one Newton step is of this size in nearly every evaluation.
 const SMALL_STEP: f64 = 1e-6;
 
-/// Below this sum of the exponentials taken by rows, they are taken node by node instead.
-const MIN_Z_BY_ROWS: f64 = 1e-200;
-
 /// Sufficient-decrease factor of the Armijo test on log Z.
 const ARMIJO: f64 = 1e-4;
 
@@ -91,11 +88,21 @@ pub struct LocalMaxEnt<const D: usize> {
     /// Largest Newton step |Delta mu|. The weights are a Gaussian centred at d = mu / (2 gamma),
     /// so the limit 2 gamma r / h moves the centre by at most the cut-off radius per step.
     max_step: f64,
+    /// exp(-2 gamma), by which the ratio of neighbouring columns' or rows' exponentials
+    /// changes from one to the next (`shifted_exponentials`).
+    decay: f64,
     max_iterations: usize,
     failures: AtomicUsize,
     /// Each particle's solution from the last `update_particles`, from which its next Newton
     /// iteration starts; `None` (a cold start) before the first and after one that fell short.
     warm: Vec<Option<Solution<D>>>,
+}
+
+/// One point's entries of a stencil, which `LocalMaxEnt::fill` writes.
+struct Slots<'a, const D: usize> {
+    node: &'a mut [u32],
+    weight: &'a mut [f64],
+    grad: &'a mut [SVector<f64, D>],
 }
 
 /// A converged multiplier mu at the scaled position s = (x - x_0) / h, with J^-1 there.
@@ -282,6 +289,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             per_axis: side as usize,
             per_point: most_within(radius, D).min(nodes as usize),
             max_step: 2.0 * gamma * radius,
+            decay: (-2.0 * gamma).exp(),
             max_iterations: MAX_ITERATIONS,
             failures: AtomicUsize::new(0),
             warm: Vec::new(),
@@ -314,7 +322,8 @@ impl<const D: usize> LocalMaxEnt<D> {
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
     ) -> Result<usize, LmeFailure> {
-        self.fill(grid, x, &mut None, node, weight, grad)
+        let slots = Slots { node, weight, grad };
+        self.fill(grid, x, &mut None, &mut Factors::default(), slots)
     }
 
     /// Fills the stencils of the particles at `positions` as `Stencils::update` does with
@@ -339,8 +348,10 @@ impl<const D: usize> LocalMaxEnt<D> {
             .zip(stencils.grad.chunks_exact_mut(k))
             .zip(positions.iter().zip(warm.iter_mut()));
         let mut outcome = Ok(());
+        let mut factors = Factors::default();
         for (p, (((node, weight), grad), (x, solution))) in chunks.enumerate() {
-            if !self.count(self.fill(grid, x, solution, node, weight, grad)) {
+            let slots = Slots { node, weight, grad };
+            if !self.count(self.fill(grid, x, solution, &mut factors, slots)) {
                 outcome = Err(p);
                 break;
             }
@@ -368,10 +379,10 @@ impl<const D: usize> LocalMaxEnt<D> {
         grid: &Grid<D>,
         x: &SVector<f64, D>,
         warm: &mut Option<Solution<D>>,
-        node: &mut [u32],
-        weight: &mut [f64],
-        grad: &mut [SVector<f64, D>],
+        factors: &mut Factors,
+        slots: Slots<D>,
     ) -> Result<usize, LmeFailure> {
+        let Slots { node, weight, grad } = slots;
         debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         if grid.locate(x).is_none() {
             return Err(LmeFailure::Outside);
@@ -443,15 +454,12 @@ impl<const D: usize> LocalMaxEnt<D> {
         let (offsets, weights) = (&grad[..selected], &mut weight[..selected]);
         let cold = SVector::zeros();
         let start_mu = warm.map_or(cold, |solution| solution.predict(&s, self.gamma));
-        let nodes = Selected {
-            offsets,
-            rows: rows.as_ref(),
-        };
-        let mut solved = self.solve(start_mu, &nodes, weights);
+        let (mut solved, mut by_rows) =
+            self.newton(start_mu, rows.as_ref(), factors, offsets, weights);
         if solved.2.is_err() && warm.is_some() {
             // A warm start that falls short (from a multiplier grown large on a face, say)
             // is not yet a failure: the cold start may still converge.
-            solved = self.solve(cold, &nodes, weights);
+            (solved, by_rows) = self.newton(cold, rows.as_ref(), factors, offsets, weights);
         }
         let (mu, at, status) = solved;
         // Eq 36 with the offsets taken about their mean r: at r = 0 it is eq 36, and at any
@@ -461,36 +469,66 @@ impl<const D: usize> LocalMaxEnt<D> {
         *warm = inverse
             .filter(|_| status.is_ok())
             .map(|inverse| Solution { s, mu, inverse });
-        for (g, p) in grad[..selected].iter_mut().zip(weight.iter()) {
-            *g = match &inverse {
-                Some(inverse) => -(inverse * (*g - at.r)) * (p * grid.inv_h()),
+        let gradient = |d: &mut SVector<f64, D>, p: f64| {
+            *d = match &inverse {
+                Some(inverse) => -(inverse * (*d - at.r)) * (p * grid.inv_h()),
                 None => SVector::zeros(),
             };
+        };
+        let (weight, grad) = (&mut weight[..selected], &mut grad[..selected]);
+        match by_rows {
+            Some(by_rows) => by_rows.write(&at.z, weight, grad, gradient),
+            None => {
+                for (d, p) in grad.iter_mut().zip(weight.iter()) {
+                    gradient(d, *p);
+                }
+            }
         }
         status
     }
 
-    /// Newton's method on log Z from `mu`, leaving the weights of the last iterate in
-    /// `weight`: that iterate, its moments, and the number of steps or why Newton stopped
-    /// short.
-    fn solve(
+    /// Newton's method on log Z from `mu`, by rows where there are rows and their largest
+    /// column and row meet at every iterate, node by node otherwise: the last iterate, its moments, and the number of
+    /// steps or why Newton stopped short, and the rows' factors, from which `ByRows::write`
+    /// takes the weights; without them the weights are left in `weight`.
+    fn newton<'a>(
+        &self,
+        mu: SVector<f64, D>,
+        rows: Option<&'a Rows>,
+        factors: &'a mut Factors,
+        offsets: &[SVector<f64, D>],
+        weight: &mut [f64],
+    ) -> (Solved<D>, Option<ByRows<'a>>) {
+        if let Some(rows) = rows {
+            let mut by_rows = ByRows::new(rows, factors, self.decay);
+            if let Ok(solved) = self.solve(mu, &mut by_rows) {
+                return (solved, Some(by_rows));
+            }
+        }
+        let Ok(solved) = self.solve(mu, &mut ByNode { offsets, weight });
+        (solved, None)
+    }
+
+    /// Newton's method on log Z from `mu` over the exponentials of `nodes`: the last iterate,
+    /// its moments, and the number of steps or why Newton stopped short; `Err` when the
+    /// exponentials cannot be taken that way at some iterate.
+    fn solve<E: Evaluation<D>>(
         &self,
         mut mu: SVector<f64, D>,
-        nodes: &Selected<D>,
-        weight: &mut [f64],
-    ) -> (SVector<f64, D>, Moments<D>, Result<usize, LmeFailure>) {
-        let mut at = Moments::at(self.gamma, &mu, nodes, weight);
+        nodes: &mut E,
+    ) -> Result<Solved<D>, E::Unusable> {
+        let mut at = nodes.moments_at(self.gamma, &mu)?;
         let mut steps = 0;
         loop {
             let residual = at.r.norm();
             if residual < RESIDUAL_TOLERANCE {
-                return (mu, at, Ok(steps));
+                return Ok((mu, at, Ok(steps)));
             }
             if steps == self.max_iterations {
-                return (mu, at, Err(LmeFailure::NotConverged { residual }));
+                return Ok((mu, at, Err(LmeFailure::NotConverged { residual })));
             }
             let Some(inverse) = spd_inverse(&at.j) else {
-                return (mu, at, Err(LmeFailure::Stalled { residual }));
+                return Ok((mu, at, Err(LmeFailure::Stalled { residual })));
             };
             let mut step = -(inverse * at.r);
             // Compared squared: the square root and division are taken only for a long step.
@@ -500,17 +538,18 @@ impl<const D: usize> LocalMaxEnt<D> {
                 length_squared = step.norm_squared();
             }
             if length_squared * (self.radius * self.radius) <= SMALL_STEP * SMALL_STEP {
-                at = at.after_small_step(&step, nodes.offsets, weight);
+                let z = nodes.small_step(&step, &at.z);
+                at = nodes.moments(z);
                 mu += step;
                 steps += 1;
                 continue;
             }
-            match self.line_search(&mu, &step, &at, nodes, weight) {
+            match self.line_search(&mu, &step, &at, nodes)? {
                 Some((next_mu, next)) => (mu, at) = (next_mu, next),
                 None => {
-                    // The rejected trials overwrote the weights.
-                    let at = Moments::at(self.gamma, &mu, nodes, weight);
-                    return (mu, at, Err(LmeFailure::Stalled { residual }));
+                    // The rejected trials replaced the exponentials.
+                    let at = nodes.moments_at(self.gamma, &mu)?;
+                    return Ok((mu, at, Err(LmeFailure::Stalled { residual })));
                 }
             }
             steps += 1;
@@ -518,15 +557,14 @@ impl<const D: usize> LocalMaxEnt<D> {
     }
 
     /// The first of mu + step, mu + step / 2, ... whose log Z passes the Armijo test (up to
-    /// round-off), with its moments and weights; `None` when every halving fails.
-    fn line_search(
+    /// round-off), with its moments; `None` when every halving fails.
+    fn line_search<E: Evaluation<D>>(
         &self,
         mu: &SVector<f64, D>,
         step: &SVector<f64, D>,
         at: &Moments<D>,
-        nodes: &Selected<D>,
-        weight: &mut [f64],
-    ) -> Option<(SVector<f64, D>, Moments<D>)> {
+        nodes: &mut E,
+    ) -> Result<Option<(SVector<f64, D>, Moments<D>)>, E::Unusable> {
         let slope = at.r.dot(step);
         let log_z = at.log_z();
         let slack = ROUNDOFF * (1.0 + log_z.abs());
@@ -534,15 +572,19 @@ impl<const D: usize> LocalMaxEnt<D> {
         for _ in 0..=MAX_HALVINGS {
             let trial_mu = mu + step * alpha;
             // The test needs log Z alone: r and J only for the trial taken.
-            let trial = Exponentials::at(self.gamma, &trial_mu, nodes, weight);
+            let trial = nodes.exponentials(self.gamma, &trial_mu)?;
             if trial.log_z() <= log_z + ARMIJO * alpha * slope + slack {
-                return Some((trial_mu, trial.moments(nodes.offsets, weight)));
+                return Ok(Some((trial_mu, nodes.moments(trial))));
             }
             alpha *= 0.5;
         }
-        None
+        Ok(None)
     }
 }
+
+/// The multiplier Newton stopped at, its moments, and the number of steps or why it stopped
+/// short.
+type Solved<const D: usize> = (SVector<f64, D>, Moments<D>, Result<usize, LmeFailure>);
 
 /// J^-1 of a covariance J, or `None` where J is not positive definite (to round-off). In 1D
 /// and 2D it is the adjugate over the determinant, one division: the Cholesky factor and its
@@ -565,12 +607,6 @@ fn spd_inverse<const D: usize>(j: &SMatrix<f64, D, D>) -> Option<SMatrix<f64, D,
         }
         _ => j.cholesky().map(|c| c.inverse()),
     }
-}
-
-/// The selected nodes of a stencil: their scaled offsets d_a, and in 2D their layout by rows.
-struct Selected<'a, const D: usize> {
-    offsets: &'a [SVector<f64, D>],
-    rows: Option<&'a Rows>,
 }
 
 /// The selected nodes in 2D as runs of columns (nodes along the first axis), one run per row
@@ -639,27 +675,6 @@ fn block_offset(s: f64, node: usize) -> f64 {
     s - index_to_f64(node)
 }
 
-/// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'
-/// offsets d_k; returns the largest.
-fn shifted_exponentials(
-    gamma: f64,
-    mu: f64,
-    offsets: impl Iterator<Item = f64>,
-    out: &mut [f64],
-) -> f64 {
-    let mut largest = f64::NEG_INFINITY;
-    for (e, d) in out.iter_mut().zip(offsets) {
-        *e = -gamma * (d * d) + mu * d;
-        if *e > largest {
-            largest = *e;
-        }
-    }
-    for e in out.iter_mut() {
-        *e = (*e - largest).exp();
-    }
-    largest
-}
-
 /// Z, r and J at one multiplier mu, in scaled units. log Z is taken when asked for: a
 /// Newton iteration that converges at its first moments or after a small step never needs
 /// the last one's.
@@ -673,140 +688,114 @@ impl<const D: usize> Moments<D> {
     fn log_z(&self) -> f64 {
         self.z.log_z()
     }
-
-    /// The moments at `mu`, leaving the weights p_a in `weight`.
-    fn at(gamma: f64, mu: &SVector<f64, D>, nodes: &Selected<D>, weight: &mut [f64]) -> Self {
-        Exponentials::at(gamma, mu, nodes, weight).moments(nodes.offsets, weight)
-    }
-
-    /// The moments at mu + `step` from the weights p_a at mu in `weight`, for a step with
-    /// |x_a| = |step . d_a| <= SMALL_STEP: p_a exp(x_a) = p_a (1 + x_a + x_a^2 / 2) to
-    /// round-off, and Z(mu + step) = Z(mu) sum_a p_a exp(x_a).
-    fn after_small_step(
-        &self,
-        step: &SVector<f64, D>,
-        offsets: &[SVector<f64, D>],
-        weight: &mut [f64],
-    ) -> Self {
-        let mut z = 0.0;
-        for (p, d) in weight.iter_mut().zip(offsets) {
-            let x = step.dot(d);
-            *p *= 1.0 + x * (1.0 + 0.5 * x);
-            z += *p;
-        }
-        Exponentials {
-            largest: self.log_z(),
-            z,
-        }
-        .moments(offsets, weight)
-    }
 }
 
-/// Z at one multiplier mu, as exp(`largest`) `z` with the exponentials exp(f_a - largest) left
-/// in the weights. `largest` is the largest f_a in 1D, and in 2D the sum of the largest column
-/// and row terms (`Rows`), so exp(f_a - largest) <= 1 either way; after a small step
-/// (`Moments::after_small_step`) it is log Z at the last multiplier, and the weights are that
-/// multiplier's p_a times exp(step . d_a).
+/// Z at one multiplier mu as exp(`largest`) `z`, where the exponentials an `Evaluation` holds
+/// are exp(f_a - largest): `largest` is at least the largest f_a when they are taken afresh,
+/// so that none overflows.
+#[derive(Clone, Copy)]
 struct Exponentials {
     largest: f64,
     z: f64,
 }
 
 impl Exponentials {
-    fn at<const D: usize>(
+    fn log_z(&self) -> f64 {
+        self.largest + self.z.ln()
+    }
+}
+
+/// The exponentials exp(f_a) of the selected nodes at Newton's current multiplier, and the
+/// moments taken from them.
+trait Evaluation<const D: usize> {
+    /// Why the exponentials cannot be taken this way at some multiplier.
+    type Unusable;
+
+    /// Takes the exponentials at `mu`, in place of the last ones.
+    fn exponentials(
+        &mut self,
         gamma: f64,
         mu: &SVector<f64, D>,
-        nodes: &Selected<D>,
-        weight: &mut [f64],
-    ) -> Self {
-        if let Some(rows) = nodes.rows {
-            let by_rows = Self::by_rows(gamma, mu, rows, weight);
-            // Z is 1 or more when the largest column and row meet at a selected node. Where
-            // they meet outside the cut-off radius it is less, and it underflows only for a
-            // huge mu (a point on a face that Newton has not resolved).
-            if by_rows.z > MIN_Z_BY_ROWS {
-                return by_rows;
-            }
-        }
+    ) -> Result<Exponentials, Self::Unusable>;
+
+    /// Multiplies the exponentials, whose sum is `z`, by exp(step . d_a) for a step with
+    /// |step . d_a| <= SMALL_STEP, as 1 + x + x^2 / 2 (the terms left out are under 1.7e-19
+    /// of a weight, below its round-off): Z at mu + `step`.
+    fn small_step(&mut self, step: &SVector<f64, D>, z: &Exponentials) -> Exponentials;
+
+    /// r and J of the exponentials, whose sum is `z`.
+    fn moments(&mut self, z: Exponentials) -> Moments<D>;
+
+    fn moments_at(
+        &mut self,
+        gamma: f64,
+        mu: &SVector<f64, D>,
+    ) -> Result<Moments<D>, Self::Unusable> {
+        let z = self.exponentials(gamma, mu)?;
+        Ok(self.moments(z))
+    }
+}
+
+/// The exponentials node by node, held in the weights: exp(f_a - largest) once taken, and
+/// normalised to p_a by `moments`.
+struct ByNode<'a, const D: usize> {
+    offsets: &'a [SVector<f64, D>],
+    weight: &'a mut [f64],
+}
+
+impl<const D: usize> Evaluation<D> for ByNode<'_, D> {
+    type Unusable = std::convert::Infallible;
+
+    fn exponentials(
+        &mut self,
+        gamma: f64,
+        mu: &SVector<f64, D>,
+    ) -> Result<Exponentials, Self::Unusable> {
         // Subtracting the largest exponent keeps exp from overflowing and Z >= 1. The exponents
         // are finite, so a comparison does what f64::max does without its NaN handling.
         let mut largest = f64::NEG_INFINITY;
-        for (p, d) in weight.iter_mut().zip(nodes.offsets) {
+        for (p, d) in self.weight.iter_mut().zip(self.offsets) {
             *p = -gamma * d.norm_squared() + mu.dot(d);
             if *p > largest {
                 largest = *p;
             }
         }
         let mut z = 0.0;
-        for p in weight.iter_mut() {
+        for p in self.weight.iter_mut() {
             *p = (*p - largest).exp();
             z += *p;
         }
-        Exponentials { largest, z }
+        Ok(Exponentials { largest, z })
     }
 
-    /// `at` with f_a split into its first axis' term and its second's (`Rows`): each column's
-    /// and each row's exponential, shifted by its largest exponent, is taken once and a node's
-    /// is their product.
-    fn by_rows<const D: usize>(
-        gamma: f64,
-        mu: &SVector<f64, D>,
-        rows: &Rows,
-        weight: &mut [f64],
-    ) -> Self {
-        let columns = rows.columns.clone();
-        let mut column = [0.0; MAX_SIDE_2D];
-        let column_largest = shifted_exponentials(
-            gamma,
-            mu[0],
-            columns.clone().map(|i| rows.offset(0, i)),
-            &mut column[columns],
-        );
-        let mut row = [0.0; MAX_SIDE_2D];
-        let row_largest = shifted_exponentials(
-            gamma,
-            mu[1],
-            (0..rows.count).map(|r| rows.offset(1, rows.first_row + r)),
-            &mut row[..rows.count],
-        );
-        let mut z = 0.0;
-        let mut rest = weight;
-        for (run, e_row) in rows.run[..rows.count].iter().zip(&row) {
-            let run = &column[run.0 as usize..run.1 as usize];
-            let (p, after) = rest.split_at_mut(run.len());
-            for (p, e_column) in p.iter_mut().zip(run) {
-                *p = e_column * e_row;
-                z += *p;
-            }
-            rest = after;
+    /// After `moments` the weights are p_a, whose sum stands for Z(mu): Z(mu + step) =
+    /// Z(mu) sum_a p_a exp(step . d_a).
+    fn small_step(&mut self, step: &SVector<f64, D>, z: &Exponentials) -> Exponentials {
+        let mut sum = 0.0;
+        for (p, d) in self.weight.iter_mut().zip(self.offsets) {
+            let x = step.dot(d);
+            *p *= 1.0 + x * (1.0 + 0.5 * x);
+            sum += *p;
         }
         Exponentials {
-            largest: column_largest + row_largest,
-            z,
+            largest: z.log_z(),
+            z: sum,
         }
     }
 
-    fn log_z(&self) -> f64 {
-        self.largest + self.z.ln()
-    }
-
-    /// Normalises the exponentials in `weight` to p_a and takes r and J from them.
-    fn moments<const D: usize>(
-        self,
-        offsets: &[SVector<f64, D>],
-        weight: &mut [f64],
-    ) -> Moments<D> {
+    /// Normalises the exponentials to p_a and takes r and J from them.
+    fn moments(&mut self, z: Exponentials) -> Moments<D> {
         let mut r = SVector::zeros();
         // One division per evaluation instead of one per node.
-        let inv_z = 1.0 / self.z;
-        for (p, d) in weight.iter_mut().zip(offsets) {
+        let inv_z = 1.0 / z.z;
+        for (p, d) in self.weight.iter_mut().zip(self.offsets) {
             *p *= inv_z;
             r += d * *p;
         }
         // The covariance sum_a p_a (d_a - r)(d_a - r)^T is eq 37's J without its cancellation,
         // summed in its lower triangle: c_k c_l = c_l c_k, so the upper one is the same.
         let mut j = SMatrix::<f64, D, D>::zeros();
-        for (p, d) in weight.iter().zip(offsets) {
+        for (p, d) in self.weight.iter().zip(self.offsets) {
             let c = d - r;
             for l in 0..D {
                 for k in l..D {
@@ -815,7 +804,263 @@ impl Exponentials {
             }
         }
         j.fill_upper_triangle_with_lower_triangle();
-        Moments { z: self, r, j }
+        Moments { z, r, j }
+    }
+}
+
+/// The largest column and row do not meet at a selected node, which takes a large mu (a
+/// point near a face that Newton has not resolved): the sums by rows could underflow or
+/// cancel.
+struct Apart;
+
+/// The exponentials in 2D by the block's columns and rows (`Rows`): f_a is a term of the
+/// node's column (its offset d along the first axis) plus a term of its row (its offset e
+/// along the second), so exp(f_a) = c_i w_j, each factor shifted by the largest of its axis.
+/// The moments are sums of such products too. About the offsets (m, n) of the largest column
+/// and row, with a row's sums C_k = sum_i c_i (d_i - m)^k over its run, Z = sum_j w_j C_0,
+/// Z (r - (m, n)) = (sum_j w_j C_1, sum_j w_j (e_j - n) C_0) and Z (J + (r - (m, n))(r - (m,
+/// n))^T) = sum_j w_j [C_2, (e_j - n) C_1; (e_j - n) C_1, (e_j - n)^2 C_0]. Newton then
+/// works on 2 per_axis factors, not on every node (about pi r^2), and the weights are written
+/// once, at the end.
+///
+/// **Round-off.** A row's C_k is a difference of prefix sums over the columns. Where the
+/// largest column and row meet at a selected node, c_i, w_j <= 1 and Z >= 1, so what the
+/// differences cancel is at most round-off of the sum of all columns times all rows, a few
+/// tens of ulps of Z. About (m, n), the mode of a unimodal distribution, J's cancellation is
+/// bounded too: (r - m)^2 <= 3 J for such a distribution, where about the origin r^2 could
+/// dwarf J (a point between nodes at a large gamma).
+struct ByRows<'a> {
+    rows: &'a Rows,
+    f: &'a mut Factors,
+    /// The offsets (m, n) of the largest column and row when the exponentials were taken.
+    mode: [f64; 2],
+    /// exp(-2 gamma).
+    decay: f64,
+    /// Z, Z (r - (m, n)) and Z (J + (r - (m, n))(r - (m, n))^T) / exp(largest): (sum_j w_j
+    /// C_0, sum_j w_j C_1, sum_j w_j (e_j - n) C_0, sum_j w_j C_2, sum_j w_j (e_j - n) C_1,
+    /// sum_j w_j (e_j - n)^2 C_0).
+    totals: [f64; 6],
+}
+
+/// The arrays of `ByRows`, kept from one point to the next so that they are not zeroed for
+/// each.
+struct Factors {
+    /// The block's columns' offsets d and exponentials c, by column.
+    column_offset: [f64; MAX_SIDE_2D],
+    column: [f64; MAX_SIDE_2D],
+    /// The rows' offsets e and exponentials w, from `Rows::first_row`.
+    row_offset: [f64; MAX_SIDE_2D],
+    row: [f64; MAX_SIDE_2D],
+    /// By column, the sums of c_i (d_i - m)^k over the columns before it from
+    /// `Rows::columns`' start. As long as a `u8` can count, so that a run's ends index it
+    /// unchecked.
+    prefix: [[f64; 3]; 256],
+}
+
+impl Default for Factors {
+    fn default() -> Self {
+        Factors {
+            column_offset: [0.0; MAX_SIDE_2D],
+            column: [0.0; MAX_SIDE_2D],
+            row_offset: [0.0; MAX_SIDE_2D],
+            row: [0.0; MAX_SIDE_2D],
+            prefix: [[0.0; 3]; 256],
+        }
+    }
+}
+
+impl<'a> ByRows<'a> {
+    fn new(rows: &'a Rows, f: &'a mut Factors, decay: f64) -> Self {
+        let columns = rows.columns.clone();
+        for (d, i) in f.column_offset[columns.clone()].iter_mut().zip(columns) {
+            *d = rows.offset(0, i);
+        }
+        for (e, j) in f.row_offset[..rows.count].iter_mut().zip(rows.first_row..) {
+            *e = rows.offset(1, j);
+        }
+        ByRows {
+            rows,
+            f,
+            decay,
+            mode: [0.0; 2],
+            totals: [0.0; 6],
+        }
+    }
+
+    /// The totals of the factors about the mode.
+    fn sum_rows(&mut self) {
+        let f = &mut *self.f;
+        let columns = self.rows.columns.clone();
+        let [m, n] = self.mode;
+        f.prefix[columns.start] = [0.0; 3];
+        for i in columns {
+            let (c, d) = (f.column[i], f.column_offset[i] - m);
+            let cd = c * d;
+            let before = f.prefix[i];
+            f.prefix[i + 1] = [before[0] + c, before[1] + cd, before[2] + cd * d];
+        }
+        let mut totals = [0.0; 6];
+        let rows = self.rows.run[..self.rows.count]
+            .iter()
+            .zip(&f.row)
+            .zip(&f.row_offset);
+        for ((run, w), e) in rows {
+            let (lo, hi) = (f.prefix[usize::from(run.0)], f.prefix[usize::from(run.1)]);
+            let sums = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+            let e = e - n;
+            let we = w * e;
+            totals[0] += w * sums[0];
+            totals[1] += w * sums[1];
+            totals[2] += we * sums[0];
+            totals[3] += w * sums[2];
+            totals[4] += we * sums[1];
+            totals[5] += we * e * sums[0];
+        }
+        self.totals = totals;
+    }
+
+    /// Writes the weights p_a = c_i w_j / Z of the factors, whose sum is `z`, in the
+    /// stencil's order, and calls `gradient(d_a, p_a)` on each node's offset.
+    fn write<const D: usize>(
+        &self,
+        z: &Exponentials,
+        weight: &mut [f64],
+        grad: &mut [SVector<f64, D>],
+        gradient: impl Fn(&mut SVector<f64, D>, f64),
+    ) {
+        let inv_z = 1.0 / z.z;
+        let (mut weight, mut grad) = (weight, grad);
+        for (run, w) in self.rows.run[..self.rows.count].iter().zip(&self.f.row) {
+            let run = &self.f.column[usize::from(run.0)..usize::from(run.1)];
+            let (p, after) = weight.split_at_mut(run.len());
+            let (d, grad_after) = grad.split_at_mut(run.len());
+            let w = w * inv_z;
+            for ((p, d), c) in p.iter_mut().zip(d).zip(run) {
+                *p = c * w;
+                gradient(d, *p);
+            }
+            (weight, grad) = (after, grad_after);
+        }
+    }
+}
+
+impl<const D: usize> Evaluation<D> for ByRows<'_> {
+    type Unusable = Apart;
+
+    fn exponentials(&mut self, gamma: f64, mu: &SVector<f64, D>) -> Result<Exponentials, Apart> {
+        let (columns, rows) = (self.rows.columns.clone(), self.rows.count);
+        let (column_largest, mode_column) = shifted_exponentials(
+            gamma,
+            self.decay,
+            mu[0],
+            &self.f.column_offset[columns.clone()],
+            &mut self.f.column[columns.clone()],
+        );
+        let (row_largest, mode_row) = shifted_exponentials(
+            gamma,
+            self.decay,
+            mu[D - 1],
+            &self.f.row_offset[..rows],
+            &mut self.f.row[..rows],
+        );
+        let (run, mode_column) = (self.rows.run[mode_row], columns.start + mode_column);
+        if !(usize::from(run.0)..usize::from(run.1)).contains(&mode_column) {
+            return Err(Apart);
+        }
+        self.mode = [
+            self.f.column_offset[mode_column],
+            self.f.row_offset[mode_row],
+        ];
+        self.sum_rows();
+        Ok(Exponentials {
+            largest: column_largest + row_largest,
+            z: self.totals[0],
+        })
+    }
+
+    /// Each factor takes its axis' part of step . d_a: exp(x + y) = exp(x) exp(y), each to
+    /// second order. The factors stay within 1e-6 of their largest's, which still meet.
+    fn small_step(&mut self, step: &SVector<f64, D>, z: &Exponentials) -> Exponentials {
+        let (columns, rows) = (self.rows.columns.clone(), self.rows.count);
+        let scale = |factors: &mut [f64], offsets: &[f64], step: f64| {
+            for (f, d) in factors.iter_mut().zip(offsets) {
+                let x = step * d;
+                *f *= 1.0 + x * (1.0 + 0.5 * x);
+            }
+        };
+        let f = &mut *self.f;
+        scale(
+            &mut f.column[columns.clone()],
+            &f.column_offset[columns],
+            step[0],
+        );
+        scale(&mut f.row[..rows], &f.row_offset[..rows], step[D - 1]);
+        self.sum_rows();
+        Exponentials {
+            largest: z.largest,
+            z: self.totals[0],
+        }
+    }
+
+    fn moments(&mut self, z: Exponentials) -> Moments<D> {
+        let inv_z = 1.0 / z.z;
+        let t = self.totals;
+        let from_mode = [t[1] * inv_z, t[2] * inv_z];
+        let second = [t[3], t[4], t[5]];
+        Moments {
+            z,
+            r: SVector::from_fn(|k, _| from_mode[k.min(1)] + self.mode[k.min(1)]),
+            j: SMatrix::from_fn(|k, l| {
+                let (k, l) = (k.min(1), l.min(1));
+                second[k + l] * inv_z - from_mode[k] * from_mode[l]
+            }),
+        }
+    }
+}
+
+/// exp(e_k - largest) into `out` for the exponents e_k = -gamma d_k^2 + mu d_k of one axis'
+/// offsets d_k, which fall by 1 from one node to the next; returns the largest and its
+/// position. Two calls of exp: the neighbours of the largest take exp(e_k - largest), and from
+/// there each next ratio exp(e_k+1 - e_k) = exp(2 gamma d_k - gamma - mu) is the last one
+/// times `decay` = exp(-2 gamma), on either side. The products carry about k^2 / 2 ulps at k
+/// nodes from the largest, as many as rounding exponents of up to gamma r^2 costs exp.
+fn shifted_exponentials(
+    gamma: f64,
+    decay: f64,
+    mu: f64,
+    offsets: &[f64],
+    out: &mut [f64],
+) -> (f64, usize) {
+    let (mut largest, mut at) = (f64::NEG_INFINITY, 0);
+    for (k, (e, d)) in out.iter_mut().zip(offsets).enumerate() {
+        *e = -gamma * (d * d) + mu * d;
+        if *e > largest {
+            (largest, at) = (*e, k);
+        }
+    }
+    let (below, rest) = out.split_at_mut(at);
+    let Some((mode, above)) = rest.split_first_mut() else {
+        return (largest, at);
+    };
+    *mode = 1.0;
+    decaying(above.iter_mut(), largest, decay);
+    decaying(below.iter_mut().rev(), largest, decay);
+    (largest, at)
+}
+
+/// The exponentials along one side of the largest, nearest first, from their exponents in
+/// `side` (`shifted_exponentials`).
+fn decaying<'a>(mut side: impl Iterator<Item = &'a mut f64>, largest: f64, decay: f64) {
+    let Some(first) = side.next() else {
+        return;
+    };
+    let mut ratio = (*first - largest).exp();
+    *first = ratio;
+    let mut last = ratio;
+    for e in side {
+        ratio *= decay;
+        last *= ratio;
+        *e = last;
     }
 }
 

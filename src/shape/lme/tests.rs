@@ -467,15 +467,24 @@ fn selected_by_rows(s: [f64; 2], side: usize, radius: f64) -> (Vec<SVector<f64, 
     (offsets, rows)
 }
 
-/// The exponentials taken by rows are those taken node by node to round-off, with the same
-/// log Z; where their sum would underflow (mu huge, the largest row and column meeting far
-/// outside the radius) they are the node-by-node ones, bit for bit.
+/// The weights of `ByRows` at `z`, in the stencil's order.
+fn row_weights(by_rows: &ByRows, z: &Exponentials, nodes: usize) -> Vec<f64> {
+    let (mut weight, mut grad) = (vec![0.0; nodes], vec![SVector::<f64, 2>::zeros(); nodes]);
+    by_rows.write(z, &mut weight, &mut grad, |_, _| {});
+    weight
+}
+
+/// Z, r, J and the weights taken by rows are those taken node by node to round-off. Where
+/// the largest column and row do not meet at a selected node (a large mu) the rows are
+/// refused, and node by node they are not.
 #[test]
-fn lme_exponentials_by_rows_match_node_by_node() {
+fn lme_moments_by_rows_match_node_by_node() {
     let mut rng = Lcg::new(11);
     for gamma in [0.3, 0.8, 3.0] {
         let radius = cut_off_radius(gamma, DEFAULT_TOLERANCE);
         let side = block_side(radius) as usize;
+        let mut factors = Factors::default();
+        let mut refused = 0;
         for trial in 0..200 {
             let s = [radius + rng.unit(), radius + rng.unit()];
             let (offsets, rows) = selected_by_rows(s, side, radius);
@@ -484,90 +493,105 @@ fn lme_exponentials_by_rows_match_node_by_node() {
                 scale * (2.0 * rng.unit() - 1.0),
                 scale * (2.0 * rng.unit() - 1.0),
             );
-            let (mut by_rows, mut by_node) = (vec![0.0; offsets.len()], vec![0.0; offsets.len()]);
-            let with_rows = Selected {
+            let mut by_node = vec![0.0; offsets.len()];
+            let b = ByNode {
                 offsets: &offsets,
-                rows: Some(&rows),
+                weight: &mut by_node,
+            }
+            .moments_at(gamma, &mu)
+            .unwrap();
+            let mut by_rows = ByRows::new(&rows, &mut factors, (-2.0 * gamma).exp());
+            let Ok(a) = by_rows.moments_at(gamma, &mu) else {
+                // Only a large mu pulls the largest column and row apart.
+                assert!(scale > 1.0, "gamma {gamma}, mu {mu:?}: refused");
+                refused += 1;
+                continue;
             };
-            let without = Selected {
-                offsets: &offsets,
-                rows: None,
-            };
-            let a = Exponentials::at(gamma, &mu, &with_rows, &mut by_rows);
-            let b = Exponentials::at(gamma, &mu, &without, &mut by_node);
             assert!((a.log_z() - b.log_z()).abs() < 1e-13 * (1.0 + b.log_z().abs()));
-            for (x, y) in by_rows.iter().zip(&by_node) {
-                assert!(
-                    (x / a.z - y / b.z).abs() < 1e-14,
-                    "gamma {gamma}, mu {mu:?}"
-                );
+            // r and J are sums of offsets up to the radius, weighted by p_a.
+            assert!(
+                (a.r - b.r).norm() < 1e-14 * radius,
+                "gamma {gamma}, mu {mu:?}"
+            );
+            assert!(
+                (a.j - b.j).norm() < 1e-14 * radius * radius,
+                "gamma {gamma}"
+            );
+            let weights = row_weights(&by_rows, &a.z, offsets.len());
+            for (x, y) in weights.iter().zip(&by_node) {
+                assert!((x - y).abs() < 1e-14, "gamma {gamma}, mu {mu:?}");
             }
         }
-        // The largest column and row meet at the corner, far off the circle, and mu makes the
-        // corner's exponent over 700 above every selected node's: the node-by-node sums are used.
+        assert!(refused < 100, "gamma {gamma}: every large mu refused");
+        // mu pulls the mass to the first column and the last row, which do not meet: the
+        // last row's run is short, and the first column is reached by the wider rows alone.
         let s = [radius, radius];
         let (offsets, rows) = selected_by_rows(s, side, radius);
-        let mu = SVector::<f64, 2>::new(4000.0 / radius, 4000.0 / radius);
-        let (mut by_rows, mut by_node) = (vec![0.0; offsets.len()], vec![0.0; offsets.len()]);
-        let a = Exponentials::at(
-            gamma,
-            &mu,
-            &Selected {
-                offsets: &offsets,
-                rows: Some(&rows),
-            },
-            &mut by_rows,
-        );
-        let b = Exponentials::at(
-            gamma,
-            &mu,
-            &Selected {
-                offsets: &offsets,
-                rows: None,
-            },
-            &mut by_node,
-        );
-        assert_eq!((a.largest, a.z), (b.largest, b.z));
-        assert_eq!(by_rows, by_node);
+        let mu = SVector::<f64, 2>::new(4000.0 / radius, -4000.0 / radius);
+        let mut by_rows = ByRows::new(&rows, &mut factors, (-2.0 * gamma).exp());
+        assert!(Evaluation::<2>::exponentials(&mut by_rows, gamma, &mu).is_err());
+        let mut by_node = vec![0.0; offsets.len()];
+        let b = ByNode {
+            offsets: &offsets,
+            weight: &mut by_node,
+        }
+        .exponentials(gamma, &mu)
+        .unwrap();
         assert!(b.z >= 1.0);
     }
 }
 
 /// A Newton step of |step . d_a| <= SMALL_STEP updates the weights, Z and the moments as
-/// evaluating them afresh at mu + step does, to round-off, in 2D as in 1D (the update does not
-/// use the rows).
+/// evaluating them afresh at mu + step does, to round-off, node by node and by rows.
 #[test]
 fn lme_small_step_matches_a_fresh_evaluation() {
     let mut rng = Lcg::new(5);
+    let mut factors = Factors::default();
     for gamma in [0.8, 3.0] {
         let radius = cut_off_radius(gamma, DEFAULT_TOLERANCE);
         let side = block_side(radius) as usize;
         for _ in 0..100 {
             let s = [radius + rng.unit(), radius + rng.unit()];
-            let (offsets, _) = selected_by_rows(s, side, radius);
-            let nodes = Selected {
-                offsets: &offsets,
-                rows: None,
-            };
+            let (offsets, rows) = selected_by_rows(s, side, radius);
             let mu = SVector::<f64, 2>::new(rng.unit() - 0.5, rng.unit() - 0.5);
             let angle = std::f64::consts::TAU * rng.unit();
             let step = SVector::<f64, 2>::new(angle.cos(), angle.sin()) * (SMALL_STEP / radius);
-            let mut updated = vec![0.0; offsets.len()];
-            let at = Moments::at(gamma, &mu, &nodes, &mut updated);
-            let small = at.after_small_step(&step, &offsets, &mut updated);
             let mut fresh = vec![0.0; offsets.len()];
-            let direct = Moments::at(gamma, &(mu + step), &nodes, &mut fresh);
-            for (a, b) in updated.iter().zip(&fresh) {
-                // A fresh evaluation rounds exponents up to gamma r^2 = 13.8: its own weights
-                // carry some 10 ulps. Leaving x^2 / 2 out would miss by up to 5e-13.
-                assert!(
-                    (a - b).abs() <= 64.0 * f64::EPSILON * b,
-                    "gamma {gamma}: {a} vs {b}"
-                );
+            let mut by_node = ByNode {
+                offsets: &offsets,
+                weight: &mut fresh,
+            };
+            let direct = by_node.moments_at(gamma, &(mu + step)).unwrap();
+            let mut updated = vec![0.0; offsets.len()];
+            let mut by_node = ByNode {
+                offsets: &offsets,
+                weight: &mut updated,
+            };
+            let at = by_node.moments_at(gamma, &mu).unwrap();
+            let z = by_node.small_step(&step, &at.z);
+            let small = by_node.moments(z);
+            let mut by_rows = ByRows::new(&rows, &mut factors, (-2.0 * gamma).exp());
+            let Ok(at) = by_rows.moments_at(gamma, &mu) else {
+                panic!("gamma {gamma}: the largest column and row apart");
+            };
+            let z = Evaluation::<2>::small_step(&mut by_rows, &step, &at.z);
+            let small_by_rows: Moments<2> = by_rows.moments(z);
+            let row_updated = row_weights(&by_rows, &small_by_rows.z, offsets.len());
+            for (small, updated) in [(small, updated), (small_by_rows, row_updated)] {
+                for (a, b) in updated.iter().zip(&fresh) {
+                    // A fresh evaluation rounds exponents up to gamma r^2 = 13.8: its own
+                    // weights carry some 10 ulps. Leaving x^2 / 2 out would miss by up to
+                    // 5e-13.
+                    assert!(
+                        (a - b).abs() <= 64.0 * f64::EPSILON * b,
+                        "gamma {gamma}: {a} vs {b}"
+                    );
+                }
+                let log_z = direct.log_z();
+                assert!((small.log_z() - log_z).abs() < 1e-14 * (1.0 + log_z.abs()));
+                assert!((small.r - direct.r).norm() < 1e-14 * radius);
+                assert!((small.j - direct.j).norm() < 1e-14 * radius * radius);
             }
-            assert!((small.log_z() - direct.log_z()).abs() < 1e-14 * (1.0 + direct.log_z().abs()));
-            assert!((small.r - direct.r).norm() < 1e-14 * radius);
-            assert!((small.j - direct.j).norm() < 1e-14 * radius * radius);
         }
     }
 }
