@@ -491,9 +491,10 @@ impl<const D: usize> LocalMaxEnt<D> {
     }
 
     /// Newton's method on log Z from `mu`, by rows where there are rows and their largest
-    /// column and row meet at every iterate, node by node otherwise: the last iterate, its moments, and the number of
-    /// steps or why Newton stopped short, and the rows' factors, from which `ByRows::write`
-    /// takes the weights; without them the weights are left in `weight`.
+    /// column and row meet at every iterate, node by node otherwise: the last iterate, its
+    /// moments, and the number of steps or why Newton stopped short, and the rows' factors,
+    /// from which `ByRows::write` takes the weights; without them the weights are left in
+    /// `weight`.
     fn newton<'a>(
         &self,
         mu: SVector<f64, D>,
@@ -614,8 +615,8 @@ fn spd_inverse<const D: usize>(j: &SMatrix<f64, D, D>) -> Option<SMatrix<f64, D,
 
 /// The selected nodes in 2D as runs of columns (nodes along the first axis), one run per row
 /// (along the second axis) of the block, in the stencil's order. |d_a|^2 and mu . d_a are
-/// sums over the axes, so exp(f_a) is the product of a column's exponential and a row's:
-/// 2 per_axis calls of exp instead of one per node (about pi r^2).
+/// sums over the axes, so exp(f_a) is the product of a column's exponential and a row's
+/// (`ByRows`), taken per column and row instead of per node (about pi r^2).
 struct Rows {
     /// The point's scaled position and the block's first node, per axis: a column's or a
     /// row's offset is taken from them by `block_offset`, as `fill` takes the nodes'.
@@ -729,6 +730,7 @@ trait Evaluation<const D: usize> {
     /// r and J of the exponentials, whose sum is `z`.
     fn moments(&mut self, z: Exponentials) -> Moments<D>;
 
+    /// `exponentials` at `mu`, then their moments.
     fn moments_at(
         &mut self,
         gamma: f64,
