@@ -324,6 +324,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             weight,
             grad,
         )
+        .0
     }
 
     /// Fills the stencils of the particles at `positions` as `Stencils::update` does with
@@ -340,6 +341,8 @@ impl<const D: usize> LocalMaxEnt<D> {
     ) -> Result<(), usize> {
         let mut warm = std::mem::take(&mut self.warm);
         warm.resize(positions.len(), None);
+        let mut leading = stencils.take_leading();
+        leading.resize(positions.len(), 0);
         let k = stencils.per_point;
         let chunks = stencils
             .node
@@ -347,16 +350,20 @@ impl<const D: usize> LocalMaxEnt<D> {
             .zip(stencils.weight.chunks_exact_mut(k))
             .zip(stencils.grad.chunks_exact_mut(k))
             .zip(positions.iter().zip(warm.iter_mut()));
-        let mut outcome = Ok(());
         let mut factors = Factors::default();
-        for (p, (((node, weight), grad), (x, solution))) in chunks.enumerate() {
-            if !self.count(self.fill(grid, x, solution, &mut factors, node, weight, grad)) {
-                outcome = Err(p);
-                break;
+        for (p, ((((node, weight), grad), (x, solution)), leading)) in
+            chunks.zip(leading.iter_mut()).enumerate()
+        {
+            let (status, selected) = self.fill(grid, x, solution, &mut factors, node, weight, grad);
+            if !self.count(status) {
+                self.warm = warm;
+                return Err(p);
             }
+            *leading = selected as u32;
         }
+        stencils.set_leading(leading);
         self.warm = warm;
-        outcome
+        Ok(())
     }
 
     /// Whether the point was on the grid; counts the evaluations that stopped short.
@@ -372,7 +379,8 @@ impl<const D: usize> LocalMaxEnt<D> {
     }
 
     /// `evaluate` with Newton starting from the prediction of `warm`, or from zero without
-    /// one; `warm` is left at this solution, or at `None` when Newton stopped short.
+    /// one, and the number of selected nodes, which lead the stencil; `warm` is left at this
+    /// solution, or at `None` when Newton stopped short.
     // The stencil's slots stay separate arguments: as `&mut` arguments they are known not to
     // alias, which a struct of them loses (0.7 % of `lme`'s instructions at gamma 3).
     #[allow(clippy::too_many_arguments)]
@@ -385,10 +393,10 @@ impl<const D: usize> LocalMaxEnt<D> {
         node: &mut [u32],
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
-    ) -> Result<usize, LmeFailure> {
+    ) -> (Result<usize, LmeFailure>, usize) {
         debug_assert_eq!(grid.dofs(), Dofs::Nodes);
         if grid.locate(x).is_none() {
-            return Err(LmeFailure::Outside);
+            return (Err(LmeFailure::Outside), 0);
         }
         let s = (x - grid.lower) * grid.inv_h();
         let start = block_from(grid, &s.add_scalar(-self.radius), self.per_axis);
@@ -487,7 +495,7 @@ impl<const D: usize> LocalMaxEnt<D> {
                 }
             }
         }
-        status
+        (status, selected)
     }
 
     /// Newton's method on log Z from `mu`, by rows where there are rows and their largest

@@ -44,6 +44,10 @@ pub struct Stencils<const D: usize> {
     /// For a basis whose values reach fewer nodes than its gradients, each point's entries
     /// with nonzero values in stencil order, padded with zero values (gradients unused).
     values: Option<Box<Stencils<D>>>,
+    /// For stencils that list the entries that can be nonzero first (LME's selected nodes),
+    /// how many each point has: the rest hold zero values and gradients, which the sums skip.
+    /// Empty when every entry counts.
+    leading: Vec<u32>,
     /// The dual-domain basis at the particles: the entries are the hat's, and the gradients
     /// are taken from the nodal averages in factored form (`DualDomain::velocity_gradients`,
     /// `DualDomain::subtract_divergence`), 2^D entries per particle instead of 4^D.
@@ -59,8 +63,37 @@ impl<const D: usize> Stencils<D> {
             weight: filled(n, 0.0, "the stencils' values"),
             grad: filled(n, SVector::zeros(), "the stencils' gradients"),
             values: None,
+            leading: Vec::new(),
             dual: None,
         }
+    }
+
+    /// The point counts of leading entries, emptied: every entry counts until `set_leading`.
+    pub fn take_leading(&mut self) -> Vec<u32> {
+        let mut leading = std::mem::take(&mut self.leading);
+        leading.clear();
+        leading
+    }
+
+    /// Marks each point p's entries after its first `leading[p]` as zero values and
+    /// gradients, which the sums then skip. A sum that holds anything but -0 is left as it is
+    /// by a zero term, so the sums keep every bit; only one made of -0 terms alone from a -0
+    /// start keeps its sign now where the skipped +0 terms made it +0.
+    pub fn set_leading(&mut self, leading: Vec<u32>) {
+        debug_assert_eq!(leading.len() * self.per_point, self.node.len());
+        debug_assert!(leading.iter().all(|&n| n as usize <= self.per_point));
+        self.leading = leading;
+    }
+
+    /// The range of point `p`'s entries that can be nonzero.
+    #[inline]
+    fn entries(&self, p: usize) -> std::ops::Range<usize> {
+        let start = p * self.per_point;
+        let count = match self.leading.get(p) {
+            Some(&n) => n as usize,
+            None => self.per_point,
+        };
+        start..start + count
     }
 
     /// Makes these the particles' stencils of the dual-domain basis with the integrals of
@@ -125,6 +158,7 @@ impl<const D: usize> Stencils<D> {
         grid: &Grid<D>,
         positions: &[SVector<f64, D>],
     ) -> Result<(), usize> {
+        self.leading.clear();
         let k = self.per_point;
         let len = k * parallel::CHUNK;
         let chunks = self
@@ -228,7 +262,7 @@ impl<const D: usize> Stencils<D> {
             // that keep a block's task to its nodes.
             for p in 0..points {
                 let value = point(p);
-                let range = p * k..(p + 1) * k;
+                let range = self.entries(p);
                 let entries = self.node[range.clone()]
                     .iter()
                     .zip(&self.weight[range.clone()]);
@@ -257,7 +291,7 @@ impl<const D: usize> Stencils<D> {
                     continue;
                 }
                 for p in c * parallel::CHUNK..((c + 1) * parallel::CHUNK).min(points) {
-                    let range = p * k..(p + 1) * k;
+                    let range = self.entries(p);
                     let nodes = &self.node[range.clone()];
                     if !nodes.iter().any(|&i| inside.contains(&(i as usize))) {
                         continue;
@@ -295,10 +329,11 @@ impl<const D: usize> Stencils<D> {
         (&self.node[range.clone()], &self.weight[range])
     }
 
-    /// Entries of particle `p`: (node, N, grad N).
+    /// Entries of particle `p`: (node, N, grad N), without the trailing zeros `set_leading`
+    /// marks.
     #[inline]
     pub fn of(&self, p: usize) -> impl Iterator<Item = (usize, f64, &SVector<f64, D>)> {
-        let range = p * self.per_point..(p + 1) * self.per_point;
+        let range = self.entries(p);
         self.node[range.clone()]
             .iter()
             .zip(&self.weight[range.clone()])

@@ -338,6 +338,22 @@ fn cold_stencils<const D: usize>(
     stencils
 }
 
+/// The entries `of` leaves out of `update_particles`' stencils are the zero ones, and there
+/// are some: the selected nodes lead each stencil.
+fn assert_skips_only_zeros<const D: usize>(stencils: &Stencils<D>) {
+    let k = stencils.per_point;
+    let mut skipped = 0;
+    for p in 0..stencils.node.len() / k {
+        let listed = stencils.of(p).count();
+        let (weight, grad) = (&stencils.weight[p * k..][..k], &stencils.grad[p * k..][..k]);
+        assert!(weight[listed..].iter().all(|&w| w == 0.0));
+        assert!(grad[listed..].iter().all(|g| g.iter().all(|&c| c == 0.0)));
+        assert!(weight[..listed].iter().all(|&w| w > 0.0), "{weight:?}");
+        skipped += k - listed;
+    }
+    assert!(skipped > 0);
+}
+
 /// `update_particles` starts cold, bit for bit `eval`'s stencils; after the particles move
 /// (off the faces too, where the last multiplier was huge) its warm starts agree with cold
 /// evaluations to the Newton tolerance, and still reproduce x to it.
@@ -353,6 +369,7 @@ fn check_warm_start<const D: usize>(gamma: f64) {
         (&warm.node, &warm.weight, &warm.grad),
         (&cold.node, &cold.weight, &cold.grad)
     );
+    assert_skips_only_zeros(&warm);
     let centre = g.lower + SVector::repeat(0.5 * g.cells as f64 * g.h);
     for pass in 1..=3 {
         let shrink = 1.0 - 1e-4 * f64::from(pass);
@@ -360,6 +377,7 @@ fn check_warm_start<const D: usize>(gamma: f64) {
             *x = centre + (*x - centre) * shrink;
         }
         lme.update_particles(&mut warm, &g, &xs).unwrap();
+        assert_skips_only_zeros(&warm);
         let cold = cold_stencils(&cold_lme, &g, &xs);
         assert_eq!(warm.node, cold.node);
         for (p, x) in xs.iter().enumerate() {
