@@ -96,6 +96,21 @@ pub struct LocalMaxEnt<const D: usize> {
     /// Each particle's solution from the last `update_particles`, from which its next Newton
     /// iteration starts; `None` (a cold start) before the first and after one that fell short.
     warm: Vec<Option<Solution<D>>>,
+    /// In 2D, each particle's block and its rows' runs of selected nodes (`per_axis` per
+    /// particle) as its stencil holds them from the last `update_particles`.
+    held_start: Vec<[u32; 2]>,
+    held_runs: Vec<(u8, u8)>,
+}
+
+/// What a particle's 2D stencil holds from the last `update_particles`: the first node of its
+/// block and each block row's run of selected nodes. `fill` writes the nodes and the
+/// zero-weight entries again only where these changed; a particle moves a small part of a
+/// cell a step, so nearly always they did not.
+struct Held<'a> {
+    start: &'a mut [u32; 2],
+    runs: &'a mut [(u8, u8)],
+    /// Whether the stencil holds what `start` and `runs` say.
+    valid: bool,
 }
 
 /// A converged multiplier mu at the scaled position s = (x - x_0) / h, with J^-1 there.
@@ -286,6 +301,8 @@ impl<const D: usize> LocalMaxEnt<D> {
             max_iterations: MAX_ITERATIONS,
             failures: AtomicUsize::new(0),
             warm: Vec::new(),
+            held_start: Vec::new(),
+            held_runs: Vec::new(),
         })
     }
 
@@ -320,6 +337,7 @@ impl<const D: usize> LocalMaxEnt<D> {
             x,
             &mut None,
             &mut Factors::default(),
+            None,
             node,
             weight,
             grad,
@@ -331,8 +349,11 @@ impl<const D: usize> LocalMaxEnt<D> {
     /// `Shape::eval`, except that each particle's Newton iteration starts from its solution of
     /// the last call, moved to its new position to first order (`Solution::predict`): a
     /// particle moves little per step, so Newton needs a step or two instead of several from
-    /// zero. The result differs from a cold start's within the Newton tolerance. Returns the
-    /// first particle outside the grid.
+    /// zero. The result differs from a cold start's within the Newton tolerance. In 2D the
+    /// stencils' nodes are written again only where a particle's selection changed: the
+    /// stencils must be those of the last call, unless their entries have been written since
+    /// (`Stencils::update`, `Stencils::reshape`), which `Stencils::take_leading` tells. Returns
+    /// the first particle outside the grid.
     pub fn update_particles(
         &mut self,
         stencils: &mut Stencils<D>,
@@ -342,7 +363,25 @@ impl<const D: usize> LocalMaxEnt<D> {
         let mut warm = std::mem::take(&mut self.warm);
         warm.resize(positions.len(), None);
         let mut leading = stencils.take_leading();
+        let (held_points, per_axis) = match D {
+            2 => (positions.len(), self.per_axis),
+            _ => (0, 0),
+        };
+        let held_len = held_points * per_axis;
+        // Held layouts describe these stencils only if the last call wrote them whole (it
+        // set the leading counts, which any other write clears) for as many particles.
+        let valid = leading.len() == positions.len() && self.held_runs.len() == held_len;
         leading.resize(positions.len(), 0);
+        let (mut held_start, mut held_runs) = (
+            std::mem::take(&mut self.held_start),
+            std::mem::take(&mut self.held_runs),
+        );
+        held_start.resize(held_points, [0; 2]);
+        held_runs.resize(held_len, (0, 0));
+        let mut held = held_start
+            .iter_mut()
+            .zip(held_runs.chunks_exact_mut(per_axis.max(1)))
+            .map(|(start, runs)| Held { start, runs, valid });
         let k = stencils.per_point;
         let chunks = stencils
             .node
@@ -354,15 +393,18 @@ impl<const D: usize> LocalMaxEnt<D> {
         for (p, ((((node, weight), grad), (x, solution)), leading)) in
             chunks.zip(leading.iter_mut()).enumerate()
         {
-            let (status, selected) = self.fill(grid, x, solution, &mut factors, node, weight, grad);
+            let held = if D == 2 { held.next() } else { None };
+            let (status, selected) =
+                self.fill(grid, x, solution, &mut factors, held, node, weight, grad);
             if !self.count(status) {
-                self.warm = warm;
+                // The leading counts stay unset, so the next call writes every stencil.
+                (self.warm, self.held_start, self.held_runs) = (warm, held_start, held_runs);
                 return Err(p);
             }
             *leading = selected as u32;
         }
         stencils.set_leading(leading);
-        self.warm = warm;
+        (self.warm, self.held_start, self.held_runs) = (warm, held_start, held_runs);
         Ok(())
     }
 
@@ -380,7 +422,8 @@ impl<const D: usize> LocalMaxEnt<D> {
 
     /// `evaluate` with Newton starting from the prediction of `warm`, or from zero without
     /// one, and the number of selected nodes, which lead the stencil; `warm` is left at this
-    /// solution, or at `None` when Newton stopped short.
+    /// solution, or at `None` when Newton stopped short. With `held` (2D) the nodes are
+    /// written only if they differ from what it says the stencil holds, and it is updated.
     // The stencil's slots stay separate arguments: as `&mut` arguments they are known not to
     // alias, which a struct of them loses (0.7 % of `lme`'s instructions at gamma 3).
     #[allow(clippy::too_many_arguments)]
@@ -390,6 +433,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         x: &SVector<f64, D>,
         warm: &mut Option<Solution<D>>,
         factors: &mut Factors,
+        mut held: Option<Held>,
         node: &mut [u32],
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
@@ -400,69 +444,73 @@ impl<const D: usize> LocalMaxEnt<D> {
         }
         let s = (x - grid.lower) * grid.inv_h();
         let start = block_from(grid, &s.add_scalar(-self.radius), self.per_axis);
-        // The selected nodes go first, their offsets d_a held in `grad` until the gradients
-        // replace them (their weights are the solver's to fill). Nodes of the block that are
-        // not selected fill the stencil from the back with zero weight and gradient, while
-        // there is room; a selected node found later may take the slot back. At the end the
-        // stencil lists each node once, the selected ones first.
-        let radius_squared = self.radius * self.radius;
-        let (mut selected, mut unused) = (0, node.len());
         // Row by row along the first axis, so that the other axes' part of the node index is
         // taken once a row; the rows' coordinates counted up, not divided out of an index
         // (perf's cycle samples sat on the two integer divisions per row).
-        let stride = grid.stride(0);
+        let radius_squared = self.radius * self.radius;
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
+        let held_start = std::array::from_fn(|k| start[k.min(D - 1)] as u32);
+        let mut unchanged = held
+            .as_ref()
+            .is_some_and(|held| held.valid && *held.start == held_start);
+        // (selected, unused): the stencil's slots taken from the front and from the back.
+        let mut ends = (0, node.len());
         let mut local = [0; D];
         let mut rows = Rows::new(&s, &start);
-        for _ in 0..self.per_axis.pow(D as u32 - 1) {
-            let row_on_grid = (1..D).all(|k| start[k] + local[k] <= grid.cells);
-            let first: usize = (1..D)
-                .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
-                .sum();
-            let index = |along: usize| (first + (start[0] + along).min(grid.cells) * stride) as u32;
-            // The offsets d_a along the other axes are the row's.
-            let across = SVector::<f64, D>::from_fn(|k, _| {
-                if k == 0 {
-                    0.0
-                } else {
-                    block_offset(s[k], start[k] + local[k])
-                }
-            });
-            let offset = |along: usize| {
-                let mut d = across;
-                d[0] = block_offset(s[0], start[0] + along);
-                d
-            };
-            let within = |along: usize| offset(along).norm_squared() <= radius_squared;
+        for row in 0..self.per_axis.pow(D as u32 - 1) {
+            let block_row = BlockRow::new(grid, &s, &start, &local);
+            let within = |along: usize| block_row.offset(along).norm_squared() <= radius_squared;
             // The row's selected nodes are a run lo..hi: the distance falls, then rises,
             // along it, and the nodes on the grid are a run from its start.
-            let (mut lo, mut hi) = (0, if row_on_grid { on_grid_along } else { 0 });
+            let (mut lo, mut hi) = (0, if block_row.on_grid { on_grid_along } else { 0 });
             while lo < hi && !within(lo) {
                 lo += 1;
             }
             while hi > lo && !within(hi - 1) {
                 hi -= 1;
             }
-            for along in (0..lo).chain(hi..self.per_axis) {
-                if unused <= selected {
-                    break;
+            match &mut held {
+                Some(held) => {
+                    // A 2D block row has at most MAX_SIDE_2D nodes, so the casts are exact.
+                    let run = (lo as u8, hi as u8);
+                    unchanged &= held.runs[row] == run;
+                    held.runs[row] = run;
+                    ends.0 += hi - lo;
                 }
-                unused -= 1;
-                node[unused] = index(along);
-                weight[unused] = 0.0;
-                grad[unused] = SVector::zeros();
-            }
-            for along in lo..hi {
-                node[selected] = index(along);
-                grad[selected] = offset(along);
-                selected += 1;
+                None => write_row(
+                    &block_row,
+                    lo..hi,
+                    self.per_axis,
+                    true,
+                    &mut ends,
+                    node,
+                    weight,
+                    grad,
+                ),
             }
             if let Some(rows) = &mut rows {
                 rows.push(lo..hi, local[D - 1]);
             }
             next_block_entry(&mut local[1..], self.per_axis);
         }
-        let (offsets, weights) = (&grad[..selected], &mut weight[..selected]);
+        let selected = ends.0;
+        if let Some(held) = held.filter(|_| !unchanged) {
+            // The nodes alone: in 2D the offsets are taken from the rows (`Rows::offsets`).
+            *held.start = held_start;
+            ends = (0, node.len());
+            let mut local = [0; D];
+            for &(lo, hi) in held.runs.iter() {
+                let block_row = BlockRow::new(grid, &s, &start, &local);
+                let run = usize::from(lo)..usize::from(hi);
+                let per_axis = self.per_axis;
+                write_row(
+                    &block_row, run, per_axis, false, &mut ends, node, weight, grad,
+                );
+                next_block_entry(&mut local[1..], self.per_axis);
+            }
+            debug_assert_eq!(ends.0, selected);
+        }
+        let (offsets, weights) = (&mut grad[..selected], &mut weight[..selected]);
         let cold = SVector::zeros();
         let start_mu = warm.map_or(cold, |solution| solution.predict(&s, self.gamma));
         let (mut solved, mut by_rows) =
@@ -480,18 +528,19 @@ impl<const D: usize> LocalMaxEnt<D> {
         *warm = inverse
             .filter(|_| status.is_ok())
             .map(|inverse| Solution { s, mu, inverse });
-        let gradient = |d: &mut SVector<f64, D>, p: f64| {
-            *d = match &inverse {
-                Some(inverse) => -(inverse * (*d - at.r)) * (p * grid.inv_h()),
+        let gradient = |g: &mut SVector<f64, D>, d: SVector<f64, D>, p: f64| {
+            *g = match &inverse {
+                Some(inverse) => -(inverse * (d - at.r)) * (p * grid.inv_h()),
                 None => SVector::zeros(),
             };
         };
         let (weight, grad) = (&mut weight[..selected], &mut grad[..selected]);
         match by_rows {
             Some(by_rows) => by_rows.write(&at.z, weight, grad, gradient),
+            // Node by node the offsets are in `grad`.
             None => {
-                for (d, p) in grad.iter_mut().zip(weight.iter()) {
-                    gradient(d, *p);
+                for (g, p) in grad.iter_mut().zip(weight.iter()) {
+                    gradient(g, *g, *p);
                 }
             }
         }
@@ -502,13 +551,14 @@ impl<const D: usize> LocalMaxEnt<D> {
     /// column and row meet at every iterate, node by node otherwise: the last iterate, its
     /// moments, and the number of steps or why Newton stopped short, and the rows' factors,
     /// from which `ByRows::write` takes the weights; without them the weights are left in
-    /// `weight`.
+    /// `weight`, and the selected nodes' offsets in `offsets` (which the rows write there
+    /// when there are rows; without rows they are there already).
     fn newton<'a>(
         &self,
         mu: SVector<f64, D>,
         rows: Option<&'a Rows>,
         factors: &'a mut Factors,
-        offsets: &[SVector<f64, D>],
+        offsets: &mut [SVector<f64, D>],
         weight: &mut [f64],
     ) -> (Solved<D>, Option<ByRows<'a>>) {
         if let Some(rows) = rows {
@@ -516,7 +566,9 @@ impl<const D: usize> LocalMaxEnt<D> {
             if let Ok(solved) = self.solve(mu, &mut by_rows) {
                 return (solved, Some(by_rows));
             }
+            rows.offsets(offsets);
         }
+        let offsets = &*offsets;
         let Ok(solved) = self.solve(mu, &mut ByNode { offsets, weight });
         (solved, None)
     }
@@ -678,6 +730,18 @@ impl Rows {
     fn offset(&self, axis: usize, index: usize) -> f64 {
         block_offset(self.s[axis], self.start[axis] + index)
     }
+
+    /// The selected nodes' offsets d_a, in the stencil's order, into `out`.
+    fn offsets<const D: usize>(&self, out: &mut [SVector<f64, D>]) {
+        let runs = self.run[..self.count].iter().zip(self.first_row..);
+        let mut out = out.iter_mut();
+        for (&(lo, hi), j) in runs {
+            for i in usize::from(lo)..usize::from(hi) {
+                let d = out.next().expect("a slot per selected node");
+                *d = SVector::from_fn(|k, _| self.offset(k.min(1), if k == 0 { i } else { j }));
+            }
+        }
+    }
 }
 
 /// The scaled offset s - node of the node numbered `node` along an axis from the scaled
@@ -685,6 +749,94 @@ impl Rows {
 #[inline]
 fn block_offset(s: f64, node: usize) -> f64 {
     s - index_to_f64(node)
+}
+
+/// One row along the first axis of a point's stencil block: its nodes' indices and offsets.
+struct BlockRow<const D: usize> {
+    /// The other axes' part of the node index.
+    first: usize,
+    /// Whether the row lies on the grid.
+    on_grid: bool,
+    /// The offsets along the other axes; the first axis' entry is the point's s.
+    across: SVector<f64, D>,
+    start: usize,
+    stride: usize,
+    cells: usize,
+}
+
+impl<const D: usize> BlockRow<D> {
+    /// The row `local` (the first axis' entry unused) of the block from `start` about the
+    /// scaled position `s`.
+    #[inline(always)]
+    fn new(grid: &Grid<D>, s: &SVector<f64, D>, start: &[usize; D], local: &[usize; D]) -> Self {
+        BlockRow {
+            first: (1..D)
+                .map(|k| (start[k] + local[k]).min(grid.cells) * grid.stride(k))
+                .sum(),
+            on_grid: (1..D).all(|k| start[k] + local[k] <= grid.cells),
+            across: SVector::from_fn(|k, _| {
+                if k == 0 {
+                    s[0]
+                } else {
+                    block_offset(s[k], start[k] + local[k])
+                }
+            }),
+            start: start[0],
+            stride: grid.stride(0),
+            cells: grid.cells,
+        }
+    }
+
+    /// The index of the row's node `along`.
+    #[inline(always)]
+    fn index(&self, along: usize) -> u32 {
+        (self.first + (self.start + along).min(self.cells) * self.stride) as u32
+    }
+
+    /// The offset d_a of the row's node `along`.
+    #[inline(always)]
+    fn offset(&self, along: usize) -> SVector<f64, D> {
+        let mut d = self.across;
+        d[0] = block_offset(self.across[0], self.start + along);
+        d
+    }
+}
+
+/// Writes a block row's entries into a stencil whose slots `ends` = (selected, unused) are
+/// taken from the front and the back: the selected nodes `run` at the front, with their
+/// offsets in `grad` if `offsets`, and the row's other nodes from the back with zero weight
+/// and gradient while there is room. A selected node found later may take such a slot back,
+/// so the full stencil lists each node once, the selected ones first.
+// The stencil's slots stay separate `&mut` arguments, as in `fill`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn write_row<const D: usize>(
+    row: &BlockRow<D>,
+    run: std::ops::Range<usize>,
+    per_axis: usize,
+    offsets: bool,
+    ends: &mut (usize, usize),
+    node: &mut [u32],
+    weight: &mut [f64],
+    grad: &mut [SVector<f64, D>],
+) {
+    let (selected, unused) = ends;
+    for along in (0..run.start).chain(run.end..per_axis) {
+        if *unused <= *selected {
+            break;
+        }
+        *unused -= 1;
+        node[*unused] = row.index(along);
+        weight[*unused] = 0.0;
+        grad[*unused] = SVector::zeros();
+    }
+    for along in run {
+        node[*selected] = row.index(along);
+        if offsets {
+            grad[*selected] = row.offset(along);
+        }
+        *selected += 1;
+    }
 }
 
 /// Z, r and J at one multiplier mu, in scaled units. log Z is taken when asked for: a
@@ -933,24 +1085,32 @@ impl<'a> ByRows<'a> {
     }
 
     /// Writes the weights p_a = c_i w_j / Z of the factors, whose sum is `z`, in the
-    /// stencil's order, and calls `gradient(d_a, p_a)` on each node's offset.
+    /// stencil's order, and calls `gradient(g_a, d_a, p_a)` on each node's gradient slot,
+    /// with its offset d_a from its column's and row's.
     fn write<const D: usize>(
         &self,
         z: &Exponentials,
         weight: &mut [f64],
         grad: &mut [SVector<f64, D>],
-        gradient: impl Fn(&mut SVector<f64, D>, f64),
+        gradient: impl Fn(&mut SVector<f64, D>, SVector<f64, D>, f64),
     ) {
         let inv_z = 1.0 / z.z;
         let (mut weight, mut grad) = (weight, grad);
-        for (run, w) in self.rows.run[..self.rows.count].iter().zip(&self.f.row) {
-            let run = &self.f.column[usize::from(run.0)..usize::from(run.1)];
-            let (p, after) = weight.split_at_mut(run.len());
-            let (d, grad_after) = grad.split_at_mut(run.len());
+        let rows = self.rows.run[..self.rows.count]
+            .iter()
+            .zip(&self.f.row)
+            .zip(&self.f.row_offset);
+        for ((run, w), &e) in rows {
+            let (lo, hi) = (usize::from(run.0), usize::from(run.1));
+            let (p, after) = weight.split_at_mut(hi - lo);
+            let (g, grad_after) = grad.split_at_mut(hi - lo);
             let w = w * inv_z;
-            for ((p, d), c) in p.iter_mut().zip(d).zip(run) {
+            let columns = self.f.column[lo..hi]
+                .iter()
+                .zip(&self.f.column_offset[lo..hi]);
+            for ((p, g), (c, &d)) in p.iter_mut().zip(g).zip(columns) {
                 *p = c * w;
-                gradient(d, *p);
+                gradient(g, SVector::from_fn(|k, _| if k == 0 { d } else { e }), *p);
             }
             (weight, grad) = (after, grad_after);
         }

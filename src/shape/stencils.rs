@@ -68,11 +68,11 @@ impl<const D: usize> Stencils<D> {
         }
     }
 
-    /// The point counts of leading entries, emptied: every entry counts until `set_leading`.
+    /// The points' counts of leading entries that the last `set_leading` recorded, or none
+    /// if the entries have been written otherwise since (`update`, `reshape`); every entry
+    /// counts until the next `set_leading`.
     pub fn take_leading(&mut self) -> Vec<u32> {
-        let mut leading = std::mem::take(&mut self.leading);
-        leading.clear();
-        leading
+        std::mem::take(&mut self.leading)
     }
 
     /// Marks each point p's entries after its first `leading[p]` as zero values and

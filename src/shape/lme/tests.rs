@@ -403,6 +403,45 @@ fn lme_warm_start_agrees_with_cold_start() {
     }
 }
 
+/// `update_particles` writes a stencil's nodes again where the selection changed, and only
+/// there, matching cold evaluations node for node, and starts afresh on stencils that were
+/// written otherwise in between.
+fn check_held_layouts<const D: usize>(gamma: f64) {
+    let g = grid::<D>(6);
+    let cold_lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    let mut lme = LocalMaxEnt::<D>::new(gamma).unwrap();
+    // The same special points, different random ones: some selections change, some do not.
+    let (xs, ys) = (
+        points(&g, 0x9e3779b97f4a7c15),
+        points(&g, 0x2545f4914f6cdd1d),
+    );
+    let mut stencils = Stencils::new(lme.nodes_per_point(), xs.len());
+    let agree = |stencils: &Stencils<D>, at: &[SVector<f64, D>]| {
+        let cold = cold_stencils(&cold_lme, &g, at);
+        assert_eq!(stencils.node, cold.node);
+        assert_skips_only_zeros(stencils);
+        for (w, wc) in stencils.weight.iter().zip(&cold.weight) {
+            assert!((w - wc).abs() < 1e-11, "{w} vs {wc}");
+        }
+    };
+    for at in [&xs, &ys, &xs] {
+        lme.update_particles(&mut stencils, &g, at).unwrap();
+        agree(&stencils, at);
+    }
+    stencils.update(&cold_lme, &g, &ys).unwrap();
+    lme.update_particles(&mut stencils, &g, &xs).unwrap();
+    agree(&stencils, &xs);
+    assert_eq!(lme.failures(), 0);
+}
+
+#[test]
+fn lme_stencils_are_rewritten_where_the_selection_changed() {
+    for gamma in PAPER_GAMMAS {
+        check_held_layouts::<1>(gamma);
+        check_held_layouts::<2>(gamma);
+    }
+}
+
 /// The most nodes the selection test admits around any of the points of a fine lattice over
 /// one cell (and its faces), counted as `fill` counts them.
 fn most_selected_on_lattice<const D: usize>(radius: f64, steps: usize) -> usize {
@@ -488,8 +527,34 @@ fn selected_by_rows(s: [f64; 2], side: usize, radius: f64) -> (Vec<SVector<f64, 
 /// The weights of `ByRows` at `z`, in the stencil's order.
 fn row_weights(by_rows: &ByRows, z: &Exponentials, nodes: usize) -> Vec<f64> {
     let (mut weight, mut grad) = (vec![0.0; nodes], vec![SVector::<f64, 2>::zeros(); nodes]);
-    by_rows.write(z, &mut weight, &mut grad, |_, _| {});
+    by_rows.write(z, &mut weight, &mut grad, |_, _, _| {});
     weight
+}
+
+/// The offsets the rows give, to `Rows::offsets` (Newton's node-by-node fallback) and to
+/// `ByRows::write` (the gradients), are those `fill` takes node by node, to the last bit.
+#[test]
+fn lme_rows_give_the_nodes_offsets() {
+    let mut rng = Lcg::new(5);
+    for gamma in PAPER_GAMMAS {
+        let radius = cut_off_radius(gamma, DEFAULT_TOLERANCE);
+        let side = block_side(radius) as usize;
+        let mut factors = Factors::default();
+        for _ in 0..100 {
+            let s = [radius + rng.unit(), radius + rng.unit()];
+            let (offsets, rows) = selected_by_rows(s, side, radius);
+            let mut from_rows = vec![SVector::<f64, 2>::zeros(); offsets.len()];
+            rows.offsets(&mut from_rows);
+            assert_eq!(from_rows, offsets);
+            let mut by_rows = ByRows::new(&rows, &mut factors, (-2.0 * gamma).exp());
+            let Ok(a) = by_rows.moments_at(gamma, &SVector::<f64, 2>::zeros()) else {
+                panic!("gamma {gamma}: refused at mu = 0");
+            };
+            let (mut weight, mut written) = (vec![0.0; offsets.len()], from_rows);
+            by_rows.write(&a.z, &mut weight, &mut written, |g, d, _| *g = d);
+            assert_eq!(written, offsets);
+        }
+    }
 }
 
 /// Z, r, J and the weights taken by rows are those taken node by node to round-off. Where
