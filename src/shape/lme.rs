@@ -109,9 +109,11 @@ pub struct LocalMaxEnt<const D: usize> {
 struct Held<'a> {
     start: &'a mut [u32; 2],
     runs: &'a mut [(u8, u8)],
-    /// Whether the stencil holds what `start` and `runs` say.
-    valid: bool,
 }
+
+/// A run no scan gives (its start past its end): a particle whose held runs are these has its
+/// stencil written afresh.
+const NOT_HELD: (u8, u8) = (1, 0);
 
 /// A converged multiplier mu at the scaled position s = (x - x_0) / h, with J^-1 there.
 #[derive(Clone, Copy, Debug)]
@@ -368,20 +370,22 @@ impl<const D: usize> LocalMaxEnt<D> {
             _ => (0, 0),
         };
         let held_len = held_points * per_axis;
-        // Held layouts describe these stencils only if the last call wrote them whole (it
-        // set the leading counts, which any other write clears) for as many particles.
-        let valid = leading.len() == positions.len() && self.held_runs.len() == held_len;
-        leading.resize(positions.len(), 0);
         let (mut held_start, mut held_runs) = (
             std::mem::take(&mut self.held_start),
             std::mem::take(&mut self.held_runs),
         );
+        // Held layouts describe these stencils only if the last call wrote them whole (it
+        // set the leading counts, which any other write clears) for as many particles.
+        if leading.len() != positions.len() || held_runs.len() != held_len {
+            held_runs.clear();
+        }
+        leading.resize(positions.len(), 0);
         held_start.resize(held_points, [0; 2]);
-        held_runs.resize(held_len, (0, 0));
+        held_runs.resize(held_len, NOT_HELD);
         let mut held = held_start
             .iter_mut()
             .zip(held_runs.chunks_exact_mut(per_axis.max(1)))
-            .map(|(start, runs)| Held { start, runs, valid });
+            .map(|(start, runs)| Held { start, runs });
         let k = stencils.per_point;
         let chunks = stencils
             .node
@@ -450,9 +454,7 @@ impl<const D: usize> LocalMaxEnt<D> {
         let radius_squared = self.radius * self.radius;
         let on_grid_along = (grid.cells + 1).saturating_sub(start[0]).min(self.per_axis);
         let held_start = std::array::from_fn(|k| start[k.min(D - 1)] as u32);
-        let mut unchanged = held
-            .as_ref()
-            .is_some_and(|held| held.valid && *held.start == held_start);
+        let mut unchanged = held.as_ref().is_some_and(|held| *held.start == held_start);
         // (selected, unused): the stencil's slots taken from the front and from the back.
         let mut ends = (0, node.len());
         let mut local = [0; D];
@@ -502,9 +504,15 @@ impl<const D: usize> LocalMaxEnt<D> {
             for &(lo, hi) in held.runs.iter() {
                 let block_row = BlockRow::new(grid, &s, &start, &local);
                 let run = usize::from(lo)..usize::from(hi);
-                let per_axis = self.per_axis;
                 write_row(
-                    &block_row, run, per_axis, false, &mut ends, node, weight, grad,
+                    &block_row,
+                    run,
+                    self.per_axis,
+                    false,
+                    &mut ends,
+                    node,
+                    weight,
+                    grad,
                 );
                 next_block_entry(&mut local[1..], self.per_axis);
             }
