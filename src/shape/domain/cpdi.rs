@@ -33,6 +33,7 @@ pub(super) struct CornerWeights<const D: usize> {
 /// int N_a = J0 + (J1 xi_a + J2 eta_a)/3. This is eq 6.30 with its "1" read as 6 V_p (as
 /// printed, the weights would not sum to one). int grad N_a is half the outward normal of
 /// the two edges at corner a: ((y_{a+1} - y_{a-1}), (x_{a-1} - x_{a+1}))/2, eq 6.32.
+#[inline(always)]
 pub(super) fn corner_weights<const D: usize>(
     corners: &[SVector<f64, D>],
 ) -> Option<CornerWeights<D>> {
@@ -48,32 +49,48 @@ pub(super) fn corner_weights<const D: usize>(
         w.gradient[0] = SVector::repeat(-1.0 / len);
         w.gradient[1] = SVector::repeat(1.0 / len);
     } else {
-        let [x1, x2, x3, x4] = [0, 1, 2, 3].map(|a| (corners[a][0], corners[a][1]));
-        let a1 = (
-            (-x1.0 + x2.0 + x3.0 - x4.0) / 4.0,
-            (-x1.1 + x2.1 + x3.1 - x4.1) / 4.0,
-        );
-        let a2 = (
-            (-x1.0 - x2.0 + x3.0 + x4.0) / 4.0,
-            (-x1.1 - x2.1 + x3.1 + x4.1) / 4.0,
-        );
-        let a3 = (
-            (x1.0 - x2.0 + x3.0 - x4.0) / 4.0,
-            (x1.1 - x2.1 + x3.1 - x4.1) / 4.0,
-        );
-        let cross = |u: (f64, f64), v: (f64, f64)| u.0 * v.1 - u.1 * v.0;
-        let (j0, j1, j2) = (cross(a1, a2), cross(a1, a3), cross(a3, a2));
+        let (j0, j1, j2) = jacobian_coefficients(corners);
         w.volume = 4.0 * j0;
-        for a in 0..4 {
+        // Opposite corners have opposite reference signs and swap next and prev, and IEEE
+        // rounding is symmetric: their terms are exact negatives, so each division is done
+        // for two corners. Divisions set the pace here; a zero's sign, the only possible
+        // difference, changes no sum of these terms.
+        let third = [(j1 + j2) / 3.0, (j1 - j2) / 3.0];
+        for a in 0..2 {
             let r = reference_corner::<2>(a);
-            w.value[a] = (j0 + (j1 * r[0] + j2 * r[1]) / 3.0) / w.volume;
-            let (next, prev) = (corners[(a + 1) % 4], corners[(a + 3) % 4]);
+            let t = third[a] * r[0];
+            w.value[a] = (j0 + t) / w.volume;
+            w.value[a + 2] = (j0 - t) / w.volume;
+            let (next, prev) = (corners[a + 1], corners[(a + 3) % 4]);
             w.gradient[a] = SVector::from_fn(|k, _| match k {
                 0 => next[1] - prev[1],
                 _ => prev[0] - next[0],
             }) / (2.0 * w.volume);
+            w.gradient[a + 2] = -w.gradient[a];
         }
     }
     // Written so that NaN fails the test.
     (w.volume > 0.0).then_some(w)
+}
+
+/// J0, J1 and J2 of the bilinear quadrilateral with the given corners (`corner_weights`); 2D.
+#[inline(always)]
+pub(super) fn jacobian_coefficients<const D: usize>(
+    corners: &[SVector<f64, D>],
+) -> (f64, f64, f64) {
+    let [x1, x2, x3, x4] = [0, 1, 2, 3].map(|a| (corners[a][0], corners[a][1]));
+    let a1 = (
+        (-x1.0 + x2.0 + x3.0 - x4.0) / 4.0,
+        (-x1.1 + x2.1 + x3.1 - x4.1) / 4.0,
+    );
+    let a2 = (
+        (-x1.0 - x2.0 + x3.0 + x4.0) / 4.0,
+        (-x1.1 - x2.1 + x3.1 + x4.1) / 4.0,
+    );
+    let a3 = (
+        (x1.0 - x2.0 + x3.0 - x4.0) / 4.0,
+        (x1.1 - x2.1 + x3.1 - x4.1) / 4.0,
+    );
+    let cross = |u: (f64, f64), v: (f64, f64)| u.0 * v.1 - u.1 * v.0;
+    (cross(a1, a2), cross(a1, a3), cross(a3, a2))
 }

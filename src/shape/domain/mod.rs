@@ -190,6 +190,7 @@ impl<const D: usize> ParticleDomains<D> {
 
     /// CPDI: the corners of particle `p`'s domain in the order of `reference_corner`, before
     /// they are moved onto the grid.
+    #[inline(always)]
     fn corners_of(&self, particles: &Particles<D>, p: usize, out: &mut [SVector<f64, D>]) {
         for (a, corner) in out.iter_mut().enumerate() {
             *corner = if self.shape == DomainShape::Quadrilateral {
@@ -293,9 +294,13 @@ fn fill_corners<const D: usize, const A: usize>(
     let local = |c: &SVector<f64, D>| (c - grid.lower) * inv_h;
     let mut lo = local(&corners[0]);
     let mut hi = lo;
+    // Plain compare-and-selects: the corners lie on the grid (clamped, and a NaN one fails
+    // `corner_weights`), so `inf` and `sup`'s NaN rules, several instructions each, are not
+    // needed.
     for c in &corners[1..] {
-        lo = lo.inf(&local(c));
-        hi = hi.sup(&local(c));
+        let c = local(c);
+        lo = lo.zip_map(&c, |l, c| if c < l { c } else { l });
+        hi = hi.zip_map(&c, |h, c| if c > h { c } else { h });
     }
     let start = block_start(grid, &lo, &hi, A)?;
     // hats[a][k][j]: the hat of the block's j-th node along axis k at corner a.

@@ -1,6 +1,6 @@
 use nalgebra::{SMatrix, SVector};
 
-use super::cpdi::{corner_weights, reference_corner};
+use super::cpdi::{corner_weights, jacobian_coefficients, reference_corner};
 use super::*;
 use crate::benchmarks::{gong_mms, thesis_params, Problem, SineMms};
 use crate::gauss::gauss_legendre;
@@ -267,6 +267,48 @@ fn quadrilateral_weights_match_quadrature() {
         );
     }
     assert!(corner_weights(&[corners[0], corners[3], corners[2], corners[1]]).is_none());
+}
+
+/// `corner_weights` divides once for each pair of opposite corners; every weight and
+/// gradient vector must equal the corner-by-corner formula of eqs 6.30 and 6.32 from the same
+/// J0, J1, J2 exactly
+/// (`==`, which takes a zero of either sign as equal), on random quadrilaterals and on the
+/// unit square, whose differences are exact and whose zeros are exact zeros.
+#[test]
+fn corner_weights_are_the_corner_by_corner_formula() {
+    let mut rng = Lcg::new(31);
+    let mut quads = vec![[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]];
+    for _ in 0..1000 {
+        let mut jiggle = |x: f64, y: f64| (x + 0.4 * rng.unit(), y + 0.4 * rng.unit());
+        quads.push([
+            jiggle(0.0, 0.0),
+            jiggle(1.0, 0.0),
+            jiggle(1.0, 1.0),
+            jiggle(0.0, 1.0),
+        ]);
+    }
+    for quad in quads {
+        let corners: Vec<SVector<f64, 2>> = quad
+            .iter()
+            .map(|&(x, y)| SVector::<f64, 2>::from([x, y]))
+            .collect();
+        let cw = corner_weights(&corners).unwrap();
+        let (j0, j1, j2) = jacobian_coefficients(&corners);
+        let volume = 4.0 * j0;
+        assert_eq!(cw.volume, volume);
+        for a in 0..4 {
+            let r = reference_corner::<2>(a);
+            let value = (j0 + (j1 * r[0] + j2 * r[1]) / 3.0) / volume;
+            let (next, prev) = (corners[(a + 1) % 4], corners[(a + 3) % 4]);
+            let gradient =
+                SVector::<f64, 2>::from([next[1] - prev[1], prev[0] - next[0]]) / (2.0 * volume);
+            assert_eq!(cw.value[a], value, "weight of corner {a} of {quad:?}");
+            assert_eq!(
+                cw.gradient[a], gradient,
+                "gradient of corner {a} of {quad:?}"
+            );
+        }
+    }
 }
 
 /// In 1D, CPDI1's interval x_p +- F l^0 and CPDI2's tracked interval give the same stencils
