@@ -120,13 +120,16 @@ pub struct Reconstructor<const D: usize> {
     axis_index: Vec<usize>,
     axis_offset: Vec<f64>,
     axis_factor: Vec<f64>,
-    /// The sums of the last fit, per pair of evaluation points (2m, 2m + 1): each of its
+    /// The sums of the last fit, per pair of evaluation points (`Pairing`): each of its
     /// components for both points side by side. They are the moment matrix, packed as
     /// `packed_len` describes, and after `fit_apply` the moments b_e = sum_p w q u_p of the
     /// velocities, term k's component l at `packed_len + 2 k + l` (`sum_components`). A row
     /// of a particle's entries reaches consecutive points, so two of its entries add to a
     /// pair's sums at once.
     pair_sums: Vec<[f64; 2]>,
+    /// How the next fit pairs the points: the pairing under which most rows of the last
+    /// one began a pair.
+    pairing: Pairing,
     coeffs: Vec<f64>,
     covered: Vec<bool>,
 }
@@ -151,6 +154,7 @@ impl<const D: usize> Reconstructor<D> {
             axis_offset: Vec::new(),
             axis_factor: Vec::new(),
             pair_sums: Vec::new(),
+            pairing: Pairing::default(),
             coeffs: vec![0.0; points * terms],
             covered: vec![false; points],
             lattice,
@@ -163,6 +167,12 @@ impl<const D: usize> Reconstructor<D> {
 
     pub fn recipe(&self) -> &Recipe {
         &self.recipe
+    }
+
+    /// The phase of the next fit's pairing of the points (`Pairing`).
+    #[cfg(test)]
+    pub(super) fn pairing_phase(&self) -> usize {
+        self.pairing.phase
     }
 
     /// Whether any particle reached evaluation point `e` in the last fit.
@@ -213,10 +223,11 @@ impl<const D: usize> Reconstructor<D> {
         out: &mut [SVector<f64, D>],
     ) -> Result<FitStats, SingularMoments> {
         const { assert!(D <= 2 && S == sum_components(T) && P == packed_len(T)) };
-        let points = self.lattice.len();
+        let pairing = self.pairing;
         self.pair_sums.clear();
-        self.pair_sums.resize(points.div_ceil(2) * S, [0.0; 2]);
-        let pairs = self.pair_sums.as_chunks_mut::<S>().0;
+        self.pair_sums
+            .resize(pairing.pairs(self.lattice.len()) * S, [0.0; 2]);
+        let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<S>().0, pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let mut tables = [PointTables::<D>::new(), PointTables::new()];
@@ -226,16 +237,20 @@ impl<const D: usize> Reconstructor<D> {
             let [a, b] = &mut tables;
             let (a, b) = (a.record(), b.record());
             let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
-            add_particle_pair::<T, P, S, D, true>(pairs, tables, degree, *vp);
+            add_particle_pair::<T, P, S, D, true>(&mut pairs, tables, degree, *vp);
         }
         for (xp, &vp) in x_rest.iter().zip(v_rest) {
             let a = tables[0].record().tabulate(&search, xp);
             for_each_row([&a], |rows| {
-                add_rows::<T, P, S, D, 1, true>(pairs, rows, degree, [vp])
+                add_rows::<T, P, S, D, 1, true>(&mut pairs, rows, degree, [vp])
             });
         }
+        self.pairing = pairs.best_pairing();
         let pairs = self.pair_sums.as_chunks::<S>().0;
-        let sums = |e: usize| (&pairs[e / 2], e % 2);
+        let sums = |e: usize| {
+            let (pair, lane) = pairing.slot(e);
+            (&pairs[pair], lane)
+        };
         let stats = solve_points::<T, P, D>(
             &self.recipe,
             &self.lattice,
@@ -267,29 +282,33 @@ impl<const D: usize> Reconstructor<D> {
     ) -> Result<FitStats, SingularMoments> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
         debug_assert_eq!(P, packed_len(T));
-        self.gather_weights::<T, P>(x);
+        let pairing = self.gather_weights::<T, P>(x);
         let pairs = self.pair_sums.as_chunks::<P>().0;
         solve_points::<T, P, D>(
             &self.recipe,
             &self.lattice,
-            |e| std::array::from_fn(|c| pairs[e / 2][c][e % 2]),
+            |e| {
+                let (pair, lane) = pairing.slot(e);
+                std::array::from_fn(|c| pairs[pair][c][lane])
+            },
             &mut self.coeffs,
             &mut self.covered,
         )
     }
 
     /// Pass one: the lattice points each particle reaches, axis by axis, and the moment
-    /// matrices, summed particle by particle in order.
-    fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) {
+    /// matrices, summed particle by particle in order. Returns how the sums are paired.
+    fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) -> Pairing {
         let record = D * self.slots;
         self.reach.resize(x.len(), [0; D]);
         self.axis_index.resize(x.len() * record, 0);
         self.axis_offset.resize(x.len() * record, 0.0);
         self.axis_factor.resize(x.len() * record, 0.0);
+        let pairing = self.pairing;
         self.pair_sums.clear();
         self.pair_sums
-            .resize(self.lattice.len().div_ceil(2) * P, [0.0; 2]);
-        let pairs = self.pair_sums.as_chunks_mut::<P>().0;
+            .resize(pairing.pairs(self.lattice.len()) * P, [0.0; 2]);
+        let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<P>().0, pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let slots = self.slots;
@@ -311,15 +330,18 @@ impl<const D: usize> Reconstructor<D> {
             let (a, b) = (records.next(), records.next());
             let (a, b) = (a.expect("a record"), b.expect("a record"));
             let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
-            add_particle_pair::<T, P, P, D, false>(pairs, tables, degree, [SVector::zeros(); 2]);
+            let u = [SVector::zeros(); 2];
+            add_particle_pair::<T, P, P, D, false>(&mut pairs, tables, degree, u);
         }
         for xp in x_rest {
             let a = records.next().expect("a record").tabulate(&search, xp);
             let u = [SVector::zeros()];
             for_each_row([&a], |rows| {
-                add_rows::<T, P, P, D, 1, false>(pairs, rows, degree, u)
+                add_rows::<T, P, P, D, 1, false>(&mut pairs, rows, degree, u)
             });
         }
+        self.pairing = pairs.best_pairing();
+        pairing
     }
 
     /// The particles' tables of the last `fit`, in order.
@@ -733,6 +755,61 @@ const fn sum_components(terms: usize) -> usize {
     packed_len(terms) + 2 * terms
 }
 
+/// Which evaluation points share a pair of `Reconstructor::pair_sums`: pair m holds points
+/// 2m - phase and 2m + 1 - phase. A row that begins a pair adds its entries two at a time
+/// from its first; one that begins on a pair's second point adds its first (and, of an even
+/// number, its last) entry alone, at about half again the cost of a pair's. On a lattice of
+/// two points per cell, the rows of even length all begin on one parity (particles two per
+/// cell and axis: every row of IMLS's field fit), and `phase` makes them begin pairs. Only
+/// where the sums are kept depends on it, not what is summed or in what order.
+#[derive(Clone, Copy, Debug, Default)]
+struct Pairing {
+    phase: usize,
+}
+
+impl Pairing {
+    /// The pair holding point `e`, and its lane there.
+    #[inline(always)]
+    fn slot(self, e: usize) -> (usize, usize) {
+        let shifted = e + self.phase;
+        (shifted / 2, shifted % 2)
+    }
+
+    /// Pairs for `points` evaluation points.
+    fn pairs(self, points: usize) -> usize {
+        (points + self.phase).div_ceil(2)
+    }
+}
+
+/// The sums of one fit under `pairing`, and how many rows began on each lane.
+struct PairSums<'a, const S: usize> {
+    sums: &'a mut [[[f64; 2]; S]],
+    pairing: Pairing,
+    starts: [usize; 2],
+}
+
+impl<'a, const S: usize> PairSums<'a, S> {
+    fn new(sums: &'a mut [[[f64; 2]; S]], pairing: Pairing) -> Self {
+        PairSums {
+            sums,
+            pairing,
+            starts: [0; 2],
+        }
+    }
+
+    /// The pairing under which most of this fit's rows would have begun a pair.
+    fn best_pairing(&self) -> Pairing {
+        let phase = self.pairing.phase;
+        Pairing {
+            phase: if self.starts[1] > self.starts[0] {
+                1 - phase
+            } else {
+                phase
+            },
+        }
+    }
+}
+
 /// Adds two consecutive particles' entries (`add_rows`), with their velocities for a
 /// `fit_apply`: together where they reach the same points (neighbours in a cell), so that
 /// each point's sums are loaded and stored once for both; else one after the other.
@@ -744,7 +821,7 @@ fn add_particle_pair<
     const D: usize,
     const VELOCITY: bool,
 >(
-    pairs: &mut [[[f64; 2]; S]],
+    pairs: &mut PairSums<'_, S>,
     (a, b): (AxisTables<'_, D>, AxisTables<'_, D>),
     degree: Degree,
     u: [SVector<f64, D>; 2],
@@ -778,23 +855,26 @@ fn add_rows<
     const M: usize,
     const VELOCITY: bool,
 >(
-    pairs: &mut [[[f64; 2]; S]],
+    pairs: &mut PairSums<'_, S>,
     rows: &[Row<'_, D>; M],
     degree: Degree,
     u: [SVector<f64, D>; M],
 ) {
     let n = rows[0].factor.len();
-    let (mut j, mut e) = (0, rows[0].first);
-    if e % 2 == 1 {
-        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut pairs[e / 2], 1, j, rows, degree, u);
-        (j, e) = (1, e + 1);
+    let (mut pair, lane) = pairs.pairing.slot(rows[0].first);
+    pairs.starts[lane] += 1;
+    let sums = &mut *pairs.sums;
+    let mut j = 0;
+    if lane == 1 {
+        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut sums[pair], 1, j, rows, degree, u);
+        (j, pair) = (1, pair + 1);
     }
     while j + 2 <= n {
-        add_entries::<T, P, S, D, 2, M, VELOCITY>(&mut pairs[e / 2], 0, j, rows, degree, u);
-        (j, e) = (j + 2, e + 2);
+        add_entries::<T, P, S, D, 2, M, VELOCITY>(&mut sums[pair], 0, j, rows, degree, u);
+        (j, pair) = (j + 2, pair + 1);
     }
     if j < n {
-        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut pairs[e / 2], 0, j, rows, degree, u);
+        add_entries::<T, P, S, D, 1, M, VELOCITY>(&mut sums[pair], 0, j, rows, degree, u);
     }
 }
 

@@ -372,3 +372,61 @@ fn a_one_pass_fit_keeps_no_entries_to_apply() {
     rec.fit_apply(&x, &v, &mut out).unwrap();
     rec.apply(&v, &mut out);
 }
+
+/// Particles two per cell and axis, jiggled, on a lattice of two Gauss points per cell: every
+/// row of a particle's entries begins on one parity, so after the first fit the pairing of the
+/// points turns to make rows begin pairs (`Pairing`). The next fit at the same positions then
+/// keeps its sums elsewhere and adds half as many entries alone, and must give the same
+/// values to the bit, by `fit` then `apply` and by `fit_apply`.
+fn check_pairing_changes_no_value<const D: usize>() {
+    let g = grid::<D>(6);
+    let mut rng = Lcg::new(5 + D as u64);
+    let per_axis = 2 * g.cells;
+    let x: Vec<SVector<f64, D>> = (0..per_axis.pow(D as u32))
+        .map(|p| {
+            SVector::from_fn(|k, _| {
+                let i = (p / per_axis.pow(k as u32)) % per_axis;
+                g.lower[k] + g.h * (0.25 + 0.5 * i as f64 + 0.04 * (rng.unit() - 0.5))
+            })
+        })
+        .collect();
+    let v: Vec<SVector<f64, D>> = x
+        .iter()
+        .map(|p| SVector::from_fn(|k, _| (k as f64 + 1.0) * p[0] - p[D - 1] * p[D - 1]))
+        .collect();
+    let r = recipe(Weight::QuadraticSpline, 1.0, Degree::LINEAR, Solver::Imls);
+    let mut fit = Reconstructor::new(r, Lattice::gauss(&g, 2));
+    let mut one_pass = Reconstructor::new(r, Lattice::gauss(&g, 2));
+    let n = fit.lattice().len();
+    let mut runs = Vec::new();
+    for _ in 0..2 {
+        let phase = (fit.pairing_phase(), one_pass.pairing_phase());
+        let mut applied = vec![SVector::<f64, D>::zeros(); n];
+        let mut fitted = applied.clone();
+        let stats = fit.fit(&x).unwrap();
+        fit.apply(&v, &mut applied);
+        assert_eq!(one_pass.fit_apply(&x, &v, &mut fitted).unwrap(), stats);
+        runs.push((phase, applied, fitted));
+    }
+    let [(before, applied_0, fitted_0), (after, applied_1, fitted_1)] = &runs[..] else {
+        unreachable!("two fits")
+    };
+    assert_eq!(
+        (*before, *after),
+        ((0, 0), (1, 1)),
+        "{D}D: the pairing turned"
+    );
+    let bits = |u: &[SVector<f64, D>]| {
+        u.iter()
+            .flat_map(|u| u.iter().map(|c| c.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(applied_0), bits(applied_1), "{D}D: fit then apply");
+    assert_eq!(bits(fitted_0), bits(fitted_1), "{D}D: one pass");
+}
+
+#[test]
+fn the_pairing_of_the_sums_changes_no_value() {
+    check_pairing_changes_no_value::<1>();
+    check_pairing_changes_no_value::<2>();
+}
