@@ -226,7 +226,7 @@ impl<const D: usize> Reconstructor<D> {
         let pairing = self.pairing;
         self.pair_sums.clear();
         self.pair_sums
-            .resize(pairing.pairs(self.lattice.len()) * S, [0.0; 2]);
+            .resize(Pairing::pairs(self.lattice.len()) * S, [0.0; 2]);
         let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<S>().0, pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
@@ -307,7 +307,7 @@ impl<const D: usize> Reconstructor<D> {
         let pairing = self.pairing;
         self.pair_sums.clear();
         self.pair_sums
-            .resize(pairing.pairs(self.lattice.len()) * P, [0.0; 2]);
+            .resize(Pairing::pairs(self.lattice.len()) * P, [0.0; 2]);
         let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<P>().0, pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
@@ -775,9 +775,10 @@ impl Pairing {
         (shifted / 2, shifted % 2)
     }
 
-    /// Pairs for `points` evaluation points.
-    fn pairs(self, points: usize) -> usize {
-        (points + self.phase).div_ceil(2)
+    /// Pairs for `points` evaluation points under either phase: the sums keep their length,
+    /// and their allocation, when the phase changes.
+    fn pairs(points: usize) -> usize {
+        points / 2 + 1
     }
 }
 
