@@ -224,10 +224,7 @@ impl<const D: usize> Reconstructor<D> {
     ) -> Result<FitStats, SingularMoments> {
         const { assert!(D <= 2 && S == sum_components(T) && P == packed_len(T)) };
         let pairing = self.pairing;
-        self.pair_sums.clear();
-        self.pair_sums
-            .resize(Pairing::pairs(self.lattice.len()) * S, [0.0; 2]);
-        let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<S>().0, pairing);
+        let mut pairs = PairSums::<S>::zeroed(&mut self.pair_sums, self.lattice.len(), pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let mut tables = [PointTables::<D>::new(), PointTables::new()];
@@ -305,10 +302,7 @@ impl<const D: usize> Reconstructor<D> {
         self.axis_offset.resize(x.len() * record, 0.0);
         self.axis_factor.resize(x.len() * record, 0.0);
         let pairing = self.pairing;
-        self.pair_sums.clear();
-        self.pair_sums
-            .resize(Pairing::pairs(self.lattice.len()) * P, [0.0; 2]);
-        let mut pairs = PairSums::new(self.pair_sums.as_chunks_mut::<P>().0, pairing);
+        let mut pairs = PairSums::<P>::zeroed(&mut self.pair_sums, self.lattice.len(), pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let slots = self.slots;
@@ -774,12 +768,6 @@ impl Pairing {
         let shifted = e + self.phase;
         (shifted / 2, shifted % 2)
     }
-
-    /// Pairs for `points` evaluation points under either phase: the sums keep their length,
-    /// and their allocation, when the phase changes.
-    fn pairs(points: usize) -> usize {
-        points / 2 + 1
-    }
 }
 
 /// The sums of one fit under `pairing`, and how many rows began on each lane.
@@ -790,9 +778,14 @@ struct PairSums<'a, const S: usize> {
 }
 
 impl<'a, const S: usize> PairSums<'a, S> {
-    fn new(sums: &'a mut [[[f64; 2]; S]], pairing: Pairing) -> Self {
+    /// `sums` zeroed for `points` evaluation points, as pairs of `S` components. They are
+    /// sized for either phase (a pair more than the points need), so that they keep their
+    /// length, and their allocation, when the phase changes.
+    fn zeroed(sums: &'a mut Vec<[f64; 2]>, points: usize, pairing: Pairing) -> Self {
+        sums.clear();
+        sums.resize((points / 2 + 1) * S, [0.0; 2]);
         PairSums {
-            sums,
+            sums: sums.as_chunks_mut::<S>().0,
             pairing,
             starts: [0; 2],
         }

@@ -271,9 +271,9 @@ fn quadrilateral_weights_match_quadrature() {
 
 /// `corner_weights` divides once for each pair of opposite corners; every weight and
 /// gradient vector must equal the corner-by-corner formula of eqs 6.30 and 6.32 from the same
-/// J0, J1, J2 exactly
-/// (`==`, which takes a zero of either sign as equal), on random quadrilaterals and on the
-/// unit square, whose differences are exact and whose zeros are exact zeros.
+/// J0, J1, J2 exactly (`==`, which takes a zero of either sign as equal), on random
+/// quadrilaterals and on the unit square, whose differences are exact and whose zeros are
+/// exact zeros.
 #[test]
 fn corner_weights_are_the_corner_by_corner_formula() {
     let mut rng = Lcg::new(31);
