@@ -14,10 +14,9 @@
 //! `VelocityFit` picks between them for the nodal velocity of a run.
 
 use std::fmt;
-use std::ops::{AddAssign, Mul};
+use std::ops::AddAssign;
 
 use nalgebra::SVector;
-use num_traits::Zero;
 
 use super::basis::{degree_of, monomials, Degree, MAX_TERMS};
 use super::kernel::{Kernel, Weight};
@@ -114,10 +113,9 @@ pub struct Reconstructor<const D: usize> {
     /// (`tabulate`); its entries are their tensor product, from which `apply` forms
     /// phi_p(x_e). Storing the axes, not the entries, keeps a particle's record to D of
     /// them, from which each entry is one product of weights again.
-    reach: Vec<[usize; D]>,
-    /// Per particle, `D * slots` of each: the lattice index part, (x_p - x_e)/h along the
-    /// axis and the 1D weight factor, axis k's from slot `k * slots`.
-    axis_index: Vec<usize>,
+    reach: Vec<Reach<D>>,
+    /// Per particle, `D * slots` of each: (x_p - x_e)/h along the axis and the 1D weight
+    /// factor of the points in reach, axis k's from slot `k * slots`.
     axis_offset: Vec<f64>,
     axis_factor: Vec<f64>,
     /// The sums of the last fit, per pair of evaluation points (`Pairing`): each of its
@@ -130,7 +128,15 @@ pub struct Reconstructor<const D: usize> {
     /// How the next fit pairs the points: the pairing under which most rows of the last
     /// one began a pair.
     pairing: Pairing,
-    coeffs: Vec<f64>,
+    /// How the last fit paired the points: its sums, its coefficients and the sums of its
+    /// applications.
+    fit_pairing: Pairing,
+    /// The coefficients c_e of the last fit, per pair of points as the sums are: term k's
+    /// of both points at `T * pair + k`.
+    coeffs: Vec<[f64; 2]>,
+    /// Room for `apply`'s sums, per pair of points as the fit's: component c's of both
+    /// points at `N * pair + c`, for values of N components.
+    applied: Vec<[f64; 2]>,
     covered: Vec<bool>,
 }
 
@@ -150,12 +156,13 @@ impl<const D: usize> Reconstructor<D> {
             radius,
             slots: per_axis,
             reach: Vec::new(),
-            axis_index: Vec::new(),
             axis_offset: Vec::new(),
             axis_factor: Vec::new(),
             pair_sums: Vec::new(),
             pairing: Pairing::default(),
-            coeffs: vec![0.0; points * terms],
+            fit_pairing: Pairing::default(),
+            coeffs: vec![[0.0; 2]; pair_count(points) * terms],
+            applied: Vec::new(),
             covered: vec![false; points],
             lattice,
         }
@@ -251,6 +258,7 @@ impl<const D: usize> Reconstructor<D> {
         let stats = solve_points::<T, P, D>(
             &self.recipe,
             &self.lattice,
+            pairing,
             |e| {
                 let (sums, lane) = sums(e);
                 std::array::from_fn(|c| sums[c][lane])
@@ -258,15 +266,17 @@ impl<const D: usize> Reconstructor<D> {
             &mut self.coeffs,
             &mut self.covered,
         )?;
+        self.fit_pairing = pairing;
         // u^h(x_e) = c_e . b_e, zero where no particle reaches.
         let coeffs = self.coeffs.as_chunks::<T>().0;
-        for (e, (u, c)) in out.iter_mut().zip(coeffs).enumerate() {
+        for (e, u) in out.iter_mut().enumerate() {
             *u = SVector::zeros();
             if self.covered[e] {
                 let (sums, lane) = sums(e);
+                let c = &coeffs[pairing.slot(e).0];
                 for k in 0..T {
                     let b_k = SVector::<f64, D>::from_fn(|l, _| sums[P + 2 * k + l][lane]);
-                    *u += b_k * c[k];
+                    *u += b_k * c[k][lane];
                 }
             }
         }
@@ -280,10 +290,12 @@ impl<const D: usize> Reconstructor<D> {
         debug_assert_eq!(degree_of::<T, D>(), self.recipe.degree);
         debug_assert_eq!(P, packed_len(T));
         let pairing = self.gather_weights::<T, P>(x);
+        self.fit_pairing = pairing;
         let pairs = self.pair_sums.as_chunks::<P>().0;
         solve_points::<T, P, D>(
             &self.recipe,
             &self.lattice,
+            pairing,
             |e| {
                 let (pair, lane) = pairing.slot(e);
                 std::array::from_fn(|c| pairs[pair][c][lane])
@@ -297,8 +309,7 @@ impl<const D: usize> Reconstructor<D> {
     /// matrices, summed particle by particle in order. Returns how the sums are paired.
     fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) -> Pairing {
         let record = D * self.slots;
-        self.reach.resize(x.len(), [0; D]);
-        self.axis_index.resize(x.len() * record, 0);
+        self.reach.resize(x.len(), Reach::default());
         self.axis_offset.resize(x.len() * record, 0.0);
         self.axis_factor.resize(x.len() * record, 0.0);
         let pairing = self.pairing;
@@ -309,13 +320,11 @@ impl<const D: usize> Reconstructor<D> {
         let mut records = self
             .reach
             .iter_mut()
-            .zip(self.axis_index.chunks_exact_mut(record))
             .zip(self.axis_offset.chunks_exact_mut(record))
             .zip(self.axis_factor.chunks_exact_mut(record))
-            .map(|(((reach, index), offset), factor)| Record {
+            .map(|((reach, offset), factor)| Record {
                 slots,
                 reach,
-                index,
                 offset,
                 factor,
             });
@@ -344,13 +353,13 @@ impl<const D: usize> Reconstructor<D> {
         let records = self
             .reach
             .iter()
-            .zip(self.axis_index.chunks_exact(record))
             .zip(self.axis_offset.chunks_exact(record))
             .zip(self.axis_factor.chunks_exact(record));
-        records.map(|(((&reach, index), offset), factor)| AxisTables {
+        let row_stride = self.lattice.stride(D - 1);
+        records.map(move |((&reach, offset), factor)| AxisTables {
             slots: self.slots,
             reach,
-            index,
+            row_stride,
             offset,
             factor,
         })
@@ -359,10 +368,7 @@ impl<const D: usize> Reconstructor<D> {
     /// u^h at every evaluation point from particle values `values` (same order as the fit),
     /// with each entry's shape function phi_p(x_e) = w q((x_p - x_e)/h) . c_e taken as it is
     /// used: a fit applied once (the leapfrog steps) does not store and reread it.
-    pub fn apply<V>(&self, values: &[V], out: &mut [V])
-    where
-        V: Copy + Zero + AddAssign + Mul<f64, Output = V>,
-    {
+    pub fn apply<V: Components>(&mut self, values: &[V], out: &mut [V]) {
         match self.terms {
             1 => self.apply_with::<1, V>(values, out),
             2 => self.apply_with::<2, V>(values, out),
@@ -372,74 +378,171 @@ impl<const D: usize> Reconstructor<D> {
         }
     }
 
-    fn apply_with<const T: usize, V>(&self, values: &[V], out: &mut [V])
-    where
-        V: Copy + Zero + AddAssign + Mul<f64, Output = V>,
-    {
-        out.fill(V::zero());
+    fn apply_with<const T: usize, V: Components>(&mut self, values: &[V], out: &mut [V]) {
+        // The component count as a constant, for the per-entry loops over components.
+        match V::COUNT {
+            1 => self.apply_components::<T, 1, V>(values, out),
+            2 => self.apply_components::<T, 2, V>(values, out),
+            3 => self.apply_components::<T, 3, V>(values, out),
+            7 => self.apply_components::<T, 7, V>(values, out),
+            n => unreachable!("no value has {n} components"),
+        }
+    }
+
+    /// `apply` for values of `N` components. The sums are kept per pair of points as the
+    /// fit's (`applied`): a row's entries land on consecutive points, so two of them take
+    /// their shape functions and add to each component's two sums at once.
+    fn apply_components<const T: usize, const N: usize, V: Components>(
+        &mut self,
+        values: &[V],
+        out: &mut [V],
+    ) {
         assert!(
             values.len() <= self.reach.len(),
             "more values than particles in the last `fit`"
         );
+        let pairing = self.fit_pairing;
+        // Taken out of `self` while its tables are read, and put back with its room.
+        let mut applied = std::mem::take(&mut self.applied);
+        applied.clear();
+        applied.resize(pair_count(self.lattice.len()) * N, [0.0; 2]);
+        let sums = applied.as_chunks_mut::<N>().0;
         let degree = degree_of::<T, D>();
         let coeffs = self.coeffs.as_chunks::<T>().0;
+        let components = |v: &V| std::array::from_fn::<f64, N, _>(|c| v.component(c));
         // Two particles at a time, as the fit summed them: where they reach the same points,
-        // each point's value is loaded and stored once for both.
+        // each point's sums are loaded and stored once for both.
         let mut tables = self.tables();
         let (pairs, rest) = values.as_chunks::<2>();
-        for &[value_a, value_b] in pairs {
+        for [value_a, value_b] in pairs {
             let (a, b) = (tables.next(), tables.next());
             let (a, b) = (a.expect("a fit entry"), b.expect("a fit entry"));
+            let (u_a, u_b) = (components(value_a), components(value_b));
             if a.same_points(&b) {
                 for_each_row([&a, &b], |rows| {
-                    apply_rows::<T, D, V, 2>(rows, [value_a, value_b], coeffs, degree, out);
+                    apply_rows::<T, N, D, 2>(sums, pairing, rows, [u_a, u_b], coeffs, degree);
                 });
             } else {
                 for_each_row([&a], |rows| {
-                    apply_rows::<T, D, V, 1>(rows, [value_a], coeffs, degree, out);
+                    apply_rows::<T, N, D, 1>(sums, pairing, rows, [u_a], coeffs, degree);
                 });
                 for_each_row([&b], |rows| {
-                    apply_rows::<T, D, V, 1>(rows, [value_b], coeffs, degree, out);
+                    apply_rows::<T, N, D, 1>(sums, pairing, rows, [u_b], coeffs, degree);
                 });
             }
         }
-        for (&value, tables) in rest.iter().zip(tables) {
+        for (value, tables) in rest.iter().zip(tables) {
+            let u = components(value);
             for_each_row([&tables], |rows| {
-                apply_rows::<T, D, V, 1>(rows, [value], coeffs, degree, out);
+                apply_rows::<T, N, D, 1>(sums, pairing, rows, [u], coeffs, degree);
             });
         }
+        for (e, out) in out.iter_mut().enumerate() {
+            let (pair, lane) = pairing.slot(e);
+            *out = V::from_components(|c| sums[pair][c][lane]);
+        }
+        self.applied = applied;
     }
 }
 
+/// A value the fits are applied to, by its components: `Reconstructor::apply` sums each
+/// component apart, two evaluation points at a time.
+pub trait Components: Copy {
+    /// How many: 1, 2, 3 or 7 (`Reconstructor::apply_with`).
+    const COUNT: usize;
+    fn component(&self, c: usize) -> f64;
+    fn from_components(component: impl Fn(usize) -> f64) -> Self;
+}
+
+impl Components for f64 {
+    const COUNT: usize = 1;
+
+    fn component(&self, _: usize) -> f64 {
+        *self
+    }
+
+    fn from_components(component: impl Fn(usize) -> f64) -> Self {
+        component(0)
+    }
+}
+
+impl<const D: usize> Components for SVector<f64, D> {
+    const COUNT: usize = D;
+
+    fn component(&self, c: usize) -> f64 {
+        self[c]
+    }
+
+    fn from_components(component: impl Fn(usize) -> f64) -> Self {
+        SVector::from_fn(|c, _| component(c))
+    }
+}
+
+/// Pairs of points that hold `points` evaluation points under either phase of `Pairing`.
+fn pair_count(points: usize) -> usize {
+    points / 2 + 1
+}
+
 /// u^h += sum_p phi_p(x_e) u_p over the rows `rows` of `M` particles that reach the same
-/// points, with their values `values`: per point, particle by particle, each entry's shape
-/// function phi_p(x_e) = w q((x_p - x_e)/h) . c_e taken as it is used.
+/// points, with their values' components `u`: per point, particle by particle, each entry's
+/// shape function phi_p(x_e) = w q((x_p - x_e)/h) . c_e taken as it is used, two entries at
+/// a time where they share a pair of points (`add_rows`).
 #[inline(always)]
-fn apply_rows<const T: usize, const D: usize, V, const M: usize>(
+fn apply_rows<const T: usize, const N: usize, const D: usize, const M: usize>(
+    applied: &mut [[[f64; 2]; N]],
+    pairing: Pairing,
     rows: &[Row<'_, D>; M],
-    values: [V; M],
-    coeffs: &[[f64; T]],
+    u: [[f64; N]; M],
+    coeffs: &[[[f64; 2]; T]],
     degree: Degree,
-    out: &mut [V],
-) where
-    V: Copy + AddAssign + Mul<f64, Output = V>,
-{
-    let first = rows[0].first;
+) {
     let n = rows[0].factor.len();
-    let (coeffs, out) = (&coeffs[first..][..n], &mut out[first..][..n]);
-    let mut q = [0.0; MAX_TERMS];
-    for (j, (c, out)) in coeffs.iter().zip(out).enumerate() {
-        for (row, &value) in rows.iter().zip(&values) {
-            let w_0 = row.factor[j];
+    let (mut pair, lane) = pairing.slot(rows[0].first);
+    let mut j = 0;
+    if lane == 1 {
+        apply_entries::<T, N, D, 1, M>(&mut applied[pair], &coeffs[pair], 1, j, rows, u, degree);
+        (j, pair) = (1, pair + 1);
+    }
+    while j + 2 <= n {
+        apply_entries::<T, N, D, 2, M>(&mut applied[pair], &coeffs[pair], 0, j, rows, u, degree);
+        (j, pair) = (j + 2, pair + 1);
+    }
+    if j < n {
+        apply_entries::<T, N, D, 1, M>(&mut applied[pair], &coeffs[pair], 0, j, rows, u, degree);
+    }
+}
+
+/// `L` consecutive entries of the `M` particles' rows from their `j`-th, on lanes
+/// `lane..lane + L` of one pair of points with coefficients `coeffs`: each component's sum
+/// += u phi, particle by particle.
+#[inline(always)]
+fn apply_entries<const T: usize, const N: usize, const D: usize, const L: usize, const M: usize>(
+    applied: &mut [[f64; 2]; N],
+    coeffs: &[[f64; 2]; T],
+    lane: usize,
+    j: usize,
+    rows: &[Row<'_, D>; M],
+    u: [[f64; N]; M],
+    degree: Degree,
+) {
+    let phi: [[f64; L]; M] = std::array::from_fn(|m| {
+        std::array::from_fn(|l| {
+            let row = &rows[m];
+            let w_0 = row.factor[j + l];
             let w = row.factor_1.map_or(w_0, |w_1| w_0 * w_1);
             let mut d = row.across;
-            d[0] = row.offset[j];
+            d[0] = row.offset[j + l];
+            let mut q = [0.0; MAX_TERMS];
             monomials(degree, &d, &mut q);
-            let phi = w * q[..T].iter().zip(c).map(|(q, c)| q * c).sum::<f64>();
-            if phi != 0.0 {
-                *out += value * phi;
-            }
-        }
+            w * q[..T]
+                .iter()
+                .zip(coeffs)
+                .map(|(q, c)| q * c[lane + l])
+                .sum::<f64>()
+        })
+    });
+    for (c, sums) in applied.iter_mut().enumerate() {
+        add_terms::<L, M>(sums, lane, |m, l| u[m][c] * phi[m][l]);
     }
 }
 
@@ -448,60 +551,63 @@ fn apply_rows<const T: usize, const D: usize, V, const M: usize>(
 fn solve_points<const T: usize, const P: usize, const D: usize>(
     recipe: &Recipe,
     lattice: &Lattice<D>,
+    pairing: Pairing,
     moments: impl Fn(usize) -> [f64; P],
-    coeffs: &mut [f64],
+    coeffs: &mut [[f64; 2]],
     covered: &mut [bool],
 ) -> Result<FitStats, SingularMoments> {
     let mut stats = FitStats::default();
     let coeffs = coeffs.as_chunks_mut::<T>().0;
-    for (e, (c, covered)) in coeffs.iter_mut().zip(covered.iter_mut()).enumerate() {
+    for (e, covered) in covered.iter_mut().enumerate() {
         let a = unpack::<T, P>(&moments(e));
         let a = &a[..];
         *covered = a[0] > 0.0;
-        if !*covered {
-            c.fill(0.0);
-            continue;
-        }
-        stats.fits += 1;
-        match recipe.solver {
-            Solver::Mls => {
-                let solved =
-                    mls_coefficients::<T>(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
-                        point: e,
-                        position: lattice.point(e).iter().copied().collect(),
-                    })?;
-                c.copy_from_slice(&solved[..T]);
-            }
-            Solver::Imls => {
-                let basis = Orthogonal::<T>::from_rows(a, MAX_TERMS, T);
-                if basis.rank() < T {
-                    stats.rank_deficient += 1;
+        let mut c = [0.0; T];
+        if *covered {
+            stats.fits += 1;
+            match recipe.solver {
+                Solver::Mls => {
+                    let solved =
+                        mls_coefficients::<T>(a, MAX_TERMS, T).ok_or_else(|| SingularMoments {
+                            point: e,
+                            position: lattice.point(e).iter().copied().collect(),
+                        })?;
+                    c.copy_from_slice(&solved[..T]);
                 }
-                c.copy_from_slice(&basis.shape_coefficients::<T>());
+                Solver::Imls => {
+                    let basis = Orthogonal::<T>::from_rows(a, MAX_TERMS, T);
+                    if basis.rank() < T {
+                        stats.rank_deficient += 1;
+                    }
+                    c = basis.shape_coefficients::<T>();
+                }
             }
+        }
+        let (pair, lane) = pairing.slot(e);
+        for (k, c) in c.into_iter().enumerate() {
+            coeffs[pair][k][lane] = c;
         }
     }
     Ok(stats)
 }
 
 /// Tabulates, axis by axis, the lattice points within `search.radius` cells of `xp` whose
-/// 1D weight is positive: axis k's n-th in slot `k * slots + n` of `index` (its part of the
-/// lattice index), `offset` ((x_p - x_e)/h along the axis) and `factor` (the weight). Returns
-/// their count per axis. A point left out lies at the edge of the support (|d| / scale
-/// rounded to the weight's radius) and adds nothing to any sum; so every entry's weight, a
-/// product of factors no smaller than about 1e-48, is positive, and the sums need no test
-/// for zero.
+/// 1D weight is positive, a run of consecutive points: axis k's n-th in slot
+/// `k * slots + n` of `offset` ((x_p - x_e)/h along the axis) and `factor` (the weight).
+/// Returns where each axis's run begins and its length. A point left out lies at the edge
+/// of the support (|d| / scale rounded to the weight's radius) and adds nothing to any sum;
+/// so every entry's weight, a product of factors no smaller than about 1e-48, is positive,
+/// and the sums need no test for zero.
 #[inline(always)]
 fn tabulate<const D: usize>(
     search: &Search<'_, D>,
     xp: &SVector<f64, D>,
     slots: usize,
-    index: &mut [usize],
     offset: &mut [f64],
     factor: &mut [f64],
-) -> [usize; D] {
+) -> Reach<D> {
     // The weight's kind is taken once a particle, not at each point it reaches.
-    let tables = (slots, index, offset, factor);
+    let tables = (slots, offset, factor);
     match search.kernel.weight {
         Weight::Hat => tabulate_with(search, xp, tables, |r| Weight::Hat.eval(r)),
         Weight::QuadraticSpline => {
@@ -516,35 +622,53 @@ fn tabulate<const D: usize>(
 fn tabulate_with<const D: usize>(
     search: &Search<'_, D>,
     xp: &SVector<f64, D>,
-    (slots, index, offset, factor): (usize, &mut [usize], &mut [f64], &mut [f64]),
+    (slots, offset, factor): (usize, &mut [f64], &mut [f64]),
     eval: impl Fn(f64) -> f64,
-) -> [usize; D] {
+) -> Reach<D> {
     let (lattice, radius, inv_scale) = (search.lattice, search.radius, 1.0 / search.kernel.scale);
-    let mut reach = [0; D];
+    let mut reach = Reach::default();
     for k in 0..D {
-        let stride = lattice.stride(k);
-        let index = &mut index[k * slots..][..slots];
         let offset = &mut offset[k * slots..][..slots];
         let factor = &mut factor[k * slots..][..slots];
-        let mut n = 0;
+        let (mut n, mut last) = (0, 0);
         lattice.near_on_axis(k, xp[k], radius, |i, dk| {
             let w = eval(dk.abs() * inv_scale);
             if w > 0.0 {
-                index[n] = i * stride;
                 offset[n] = -dk;
                 factor[n] = w;
                 n += 1;
+                last = i;
             }
         });
-        reach[k] = n;
+        // The weight falls with the distance, so the points kept are a run: the last one
+        // and their count place it.
+        reach.first[k] = (last + 1).saturating_sub(n) * lattice.stride(k);
+        reach.count[k] = n;
     }
     reach
 }
 
+/// Where one particle's entries lie: along each axis, a run of `count` consecutive lattice
+/// points from the one whose lattice index part is `first`. Its entries are the runs'
+/// tensor product.
+#[derive(Clone, Copy, Debug)]
+struct Reach<const D: usize> {
+    first: [usize; D],
+    count: [usize; D],
+}
+
+impl<const D: usize> Default for Reach<D> {
+    fn default() -> Self {
+        Reach {
+            first: [0; D],
+            count: [0; D],
+        }
+    }
+}
+
 /// Room for one particle's `AxisTables`, for a fit that does not keep them (`fit_apply`).
 struct PointTables<const D: usize> {
-    reach: [usize; D],
-    index: [[usize; MAX_PER_AXIS]; D],
+    reach: Reach<D>,
     offset: [[f64; MAX_PER_AXIS]; D],
     factor: [[f64; MAX_PER_AXIS]; D],
 }
@@ -552,8 +676,7 @@ struct PointTables<const D: usize> {
 impl<const D: usize> PointTables<D> {
     fn new() -> Self {
         PointTables {
-            reach: [0; D],
-            index: [[0; MAX_PER_AXIS]; D],
+            reach: Reach::default(),
             offset: [[0.0; MAX_PER_AXIS]; D],
             factor: [[0.0; MAX_PER_AXIS]; D],
         }
@@ -564,7 +687,6 @@ impl<const D: usize> PointTables<D> {
         Record {
             slots: MAX_PER_AXIS,
             reach: &mut self.reach,
-            index: self.index.as_flattened_mut(),
             offset: self.offset.as_flattened_mut(),
             factor: self.factor.as_flattened_mut(),
         }
@@ -591,8 +713,7 @@ impl<'a, const D: usize> Search<'a, D> {
 /// Room for one particle's `AxisTables`, `slots` per axis.
 struct Record<'a, const D: usize> {
     slots: usize,
-    reach: &'a mut [usize; D],
-    index: &'a mut [usize],
+    reach: &'a mut Reach<D>,
     offset: &'a mut [f64],
     factor: &'a mut [f64],
 }
@@ -601,11 +722,11 @@ impl<'a, const D: usize> Record<'a, D> {
     /// Fills the record for a particle at `xp` (`tabulate`) and reads it as its tables.
     #[inline(always)]
     fn tabulate(self, search: &Search<'_, D>, xp: &SVector<f64, D>) -> AxisTables<'a, D> {
-        *self.reach = tabulate(search, xp, self.slots, self.index, self.offset, self.factor);
+        *self.reach = tabulate(search, xp, self.slots, self.offset, self.factor);
         AxisTables {
             slots: self.slots,
             reach: *self.reach,
-            index: self.index,
+            row_stride: search.lattice.stride(D - 1),
             offset: self.offset,
             factor: self.factor,
         }
@@ -616,8 +737,9 @@ impl<'a, const D: usize> Record<'a, D> {
 /// are their tensor product.
 struct AxisTables<'a, const D: usize> {
     slots: usize,
-    reach: [usize; D],
-    index: &'a [usize],
+    reach: Reach<D>,
+    /// The lattice stride of the last axis: from one row of entries to the next.
+    row_stride: usize,
     offset: &'a [f64],
     factor: &'a [f64],
 }
@@ -628,9 +750,8 @@ impl<const D: usize> AxisTables<'_, D> {
     #[inline(always)]
     fn same_points(&self, other: &Self) -> bool {
         (0..D).all(|k| {
-            let n = self.reach[k];
-            n == other.reach[k]
-                && (n == 0 || self.index[k * self.slots] == other.index[k * other.slots])
+            let n = self.reach.count[k];
+            n == other.reach.count[k] && (n == 0 || self.reach.first[k] == other.reach.first[k])
         })
     }
 }
@@ -647,14 +768,11 @@ fn for_each_row<const D: usize, const M: usize>(
     const { assert!(D == 1 || D == 2, "the fits' bases are 1D and 2D") };
     let lead = tables[0];
     debug_assert!(tables.iter().all(|t| t.same_points(lead)));
-    let n = lead.reach[0];
+    let n = lead.reach.count[0];
     if n == 0 {
         return;
     }
-    debug_assert!(lead.index[..n]
-        .windows(2)
-        .all(|pair| pair[1] == pair[0] + 1));
-    let first = lead.index[0];
+    let first = lead.reach.first[0];
     if D == 1 {
         visit(&tables.map(|t| Row {
             first,
@@ -665,8 +783,8 @@ fn for_each_row<const D: usize, const M: usize>(
         }));
         return;
     }
-    for r in 0..lead.reach[1] {
-        let row_index = lead.index[lead.slots + r];
+    for r in 0..lead.reach.count[1] {
+        let row_index = lead.reach.first[D - 1] + r * lead.row_stride;
         visit(&tables.map(|t| {
             let mut across = SVector::zeros();
             across[D - 1] = t.offset[t.slots + r];
@@ -726,7 +844,7 @@ impl<const D: usize> VelocityFit<D> {
     }
 
     /// The last mapping's fit applied to the velocities `v` now.
-    pub fn remap(&self, v: &[SVector<f64, D>], out: &mut [SVector<f64, D>]) {
+    pub fn remap(&mut self, v: &[SVector<f64, D>], out: &mut [SVector<f64, D>]) {
         assert!(
             self.remaps,
             "a velocity fit built without remapping remapped"
@@ -783,7 +901,7 @@ impl<'a, const S: usize> PairSums<'a, S> {
     /// length, and their allocation, when the phase changes.
     fn zeroed(sums: &'a mut Vec<[f64; 2]>, points: usize, pairing: Pairing) -> Self {
         sums.clear();
-        sums.resize((points / 2 + 1) * S, [0.0; 2]);
+        sums.resize(pair_count(points) * S, [0.0; 2]);
         PairSums {
             sums: sums.as_chunks_mut::<S>().0,
             pairing,

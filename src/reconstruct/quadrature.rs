@@ -5,11 +5,10 @@
 //! points, where the nodal masses and forces are integrated.
 
 use std::fmt;
-use std::ops::{Add, AddAssign, Mul};
 
 use nalgebra::{SMatrix, SVector};
-use num_traits::Zero;
 
+use super::least_squares::Components;
 use super::shepard::{map_velocity, remap_velocity};
 use super::{FitStats, Lattice, Recipe, Reconstructor, SingularMoments, VelocityFit};
 use crate::catalog::{names_of, Catalog, Entry, Parts};
@@ -125,48 +124,25 @@ struct Fields<const D: usize> {
     body: SVector<f64, D>,
 }
 
-impl<const D: usize> Zero for Fields<D> {
-    fn zero() -> Self {
-        Fields {
-            density: 0.0,
-            stress: SMatrix::zeros(),
-            body: SVector::zeros(),
+/// Density, then the stress column by column, then the body force.
+impl<const D: usize> Components for Fields<D> {
+    const COUNT: usize = 1 + D * D + D;
+
+    #[inline(always)]
+    fn component(&self, c: usize) -> f64 {
+        match c {
+            0 => self.density,
+            c if c <= D * D => self.stress.as_slice()[c - 1],
+            c => self.body[c - 1 - D * D],
         }
     }
 
-    fn is_zero(&self) -> bool {
-        *self == Self::zero()
-    }
-}
-
-impl<const D: usize> Add for Fields<D> {
-    type Output = Self;
-
-    fn add(self, other: Self) -> Self {
+    #[inline(always)]
+    fn from_components(component: impl Fn(usize) -> f64) -> Self {
         Fields {
-            density: self.density + other.density,
-            stress: self.stress + other.stress,
-            body: self.body + other.body,
-        }
-    }
-}
-
-impl<const D: usize> AddAssign for Fields<D> {
-    fn add_assign(&mut self, other: Self) {
-        self.density += other.density;
-        self.stress += other.stress;
-        self.body += other.body;
-    }
-}
-
-impl<const D: usize> Mul<f64> for Fields<D> {
-    type Output = Self;
-
-    fn mul(self, phi: f64) -> Self {
-        Fields {
-            density: self.density * phi,
-            stress: self.stress * phi,
-            body: self.body * phi,
+            density: component(0),
+            stress: SMatrix::from_fn(|i, j| component(1 + i + D * j)),
+            body: SVector::from_fn(|k, _| component(1 + D * D + k)),
         }
     }
 }
@@ -193,7 +169,7 @@ impl<const D: usize> QuadratureTransfer<D> {
             basis,
             weights,
             particle_fields: Vec::new(),
-            fields_at_points: vec![Fields::zero(); n],
+            fields_at_points: vec![Fields::from_components(|_| 0.0); n],
             body_force: recipe.body_force,
         }
     }
@@ -256,13 +232,13 @@ impl<const D: usize> QuadratureTransfer<D> {
     /// The velocity fit of this step applied to the particle velocities now (Tran eq 36), or
     /// their Shepard average with this step's weights and Shepard masses.
     pub fn remap_velocity(
-        &self,
+        &mut self,
         stencils: &Stencils<D>,
         particles: &Particles<D>,
         empty_mass: f64,
         out: &mut [SVector<f64, D>],
     ) {
-        match &self.velocity {
+        match &mut self.velocity {
             VelocityMap::Fit(fit) => fit.remap(&particles.v, out),
             VelocityMap::Shepard(mass) => {
                 remap_velocity(stencils, particles, mass, empty_mass, out)
@@ -393,7 +369,7 @@ mod tests {
         let (mut mpm, mut impm, mut fields) = (fresh(), fresh(), fresh());
         map(&mut mpm, None);
         map(&mut impm, Some(preset_recipe("impm")));
-        let transfer = map(&mut fields, Some(preset_recipe("impm_fields_only"))).unwrap();
+        let mut transfer = map(&mut fields, Some(preset_recipe("impm_fields_only"))).unwrap();
         let largest = |a: &[SVector<f64, D>], b: &[SVector<f64, D>]| {
             a.iter()
                 .zip(b)
@@ -551,6 +527,24 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The fields' components are density, the stress column by column and the body force,
+    /// and they make the same fields again.
+    #[test]
+    fn fields_are_their_components() {
+        let fields = Fields::<2> {
+            density: 1.0,
+            stress: SMatrix::<f64, 2, 2>::new(2.0, 4.0, 3.0, 5.0),
+            body: SVector::<f64, 2>::new(6.0, 7.0),
+        };
+        let components: Vec<f64> = (0..Fields::<2>::COUNT)
+            .map(|c| fields.component(c))
+            .collect();
+        assert_eq!(components, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        assert_eq!(Fields::<2>::from_components(|c| components[c]), fields);
+        let one = Fields::<1>::from_components(|c| c as f64 + 1.0);
+        assert_eq!((one.density, one.stress[0], one.body[0]), (1.0, 2.0, 3.0));
     }
 
     /// One Gauss point per cell and axis is the cell centre, with the cell's volume as weight

@@ -430,3 +430,38 @@ fn the_pairing_of_the_sums_changes_no_value() {
     check_pairing_changes_no_value::<1>();
     check_pairing_changes_no_value::<2>();
 }
+
+/// An application to values of several components (`Components`) sums each component as an
+/// application to that component alone does, to the bit, on either pairing of the points.
+fn check_components_apply_apart<const D: usize>() {
+    let g = grid::<D>(5);
+    let x = random_points::<D>(150 * D * D, 17 + D as u64);
+    let v: Vec<SVector<f64, D>> = x
+        .iter()
+        .map(|p| SVector::from_fn(|k, _| (2.0 - k as f64) * p[0] + p[D - 1] * p[D - 1]))
+        .collect();
+    for lattice in [Lattice::nodes(&g), Lattice::gauss(&g, 2)] {
+        let r = recipe(Weight::QuadraticSpline, 1.0, Degree::LINEAR, Solver::Mls);
+        let mut fit = Reconstructor::new(r, lattice);
+        let n = fit.lattice().len();
+        for _ in 0..2 {
+            fit.fit(&x).unwrap();
+            let mut together = vec![SVector::<f64, D>::zeros(); n];
+            fit.apply(&v, &mut together);
+            for k in 0..D {
+                let component: Vec<f64> = v.iter().map(|v| v[k]).collect();
+                let mut apart = vec![0.0; n];
+                fit.apply(&component, &mut apart);
+                for (e, (u, a)) in together.iter().zip(&apart).enumerate() {
+                    assert_eq!(u[k].to_bits(), a.to_bits(), "{D}D point {e} component {k}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn an_application_sums_each_component_apart() {
+    check_components_apply_apart::<1>();
+    check_components_apply_apart::<2>();
+}
