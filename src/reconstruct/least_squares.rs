@@ -379,23 +379,34 @@ impl<const D: usize> Reconstructor<D> {
     }
 
     fn apply_with<const T: usize, V: Components>(&mut self, values: &[V], out: &mut [V]) {
-        // The component count as a constant, for the per-entry loops over components.
-        match V::COUNT {
-            1 => self.apply_components::<T, 1, V>(values, out),
-            2 => self.apply_components::<T, 2, V>(values, out),
-            3 => self.apply_components::<T, 3, V>(values, out),
-            7 => self.apply_components::<T, 7, V>(values, out),
-            n => unreachable!("no value has {n} components"),
+        // A last component that copies another in every value has that one's sums to the
+        // bit: each point receives the same terms in the same order.
+        let last = V::COUNT - 1;
+        let copied = V::LAST_MAY_COPY.filter(|&of| {
+            values
+                .iter()
+                .all(|v| v.component(last).to_bits() == v.component(of).to_bits())
+        });
+        // The count of components summed as a constant, for the per-entry loops over them.
+        match (V::COUNT, copied) {
+            (1, None) => self.apply_components::<T, 1, V>(values, out, None),
+            (2, None) => self.apply_components::<T, 2, V>(values, out, None),
+            (3, None) => self.apply_components::<T, 3, V>(values, out, None),
+            (7, None) => self.apply_components::<T, 7, V>(values, out, None),
+            (7, copied) => self.apply_components::<T, 6, V>(values, out, copied),
+            (n, _) => unreachable!("no value has {n} components"),
         }
     }
 
-    /// `apply` for values of `N` components. The sums are kept per pair of points as the
+    /// `apply` summing the first `N` components of the values; a last component beyond
+    /// them takes the sums of component `copied`. The sums are kept per pair of points as the
     /// fit's (`applied`): a row's entries land on consecutive points, so two of them take
     /// their shape functions and add to each component's two sums at once.
     fn apply_components<const T: usize, const N: usize, V: Components>(
         &mut self,
         values: &[V],
         out: &mut [V],
+        copied: Option<usize>,
     ) {
         assert!(
             values.len() <= self.reach.len(),
@@ -437,9 +448,13 @@ impl<const D: usize> Reconstructor<D> {
                 apply_rows::<T, N, D, 1>(sums, pairing, rows, [u], coeffs, degree);
             });
         }
+        let source = |c: usize| match copied {
+            Some(of) if c == N => of,
+            _ => c,
+        };
         for (e, out) in out.iter_mut().enumerate() {
             let (pair, lane) = pairing.slot(e);
-            *out = V::from_components(|c| sums[pair][c][lane]);
+            *out = V::from_components(|c| sums[pair][source(c)][lane]);
         }
         self.applied = applied;
     }
@@ -450,6 +465,9 @@ impl<const D: usize> Reconstructor<D> {
 pub trait Components: Copy {
     /// How many: 1, 2, 3 or 7 (`Reconstructor::apply_with`).
     const COUNT: usize;
+    /// A component the last one may copy (the quadrature fields: a symmetric stress). Where
+    /// it does in every value, `apply` sums the last component once, as that one.
+    const LAST_MAY_COPY: Option<usize> = None;
     fn component(&self, c: usize) -> f64;
     fn from_components(component: impl Fn(usize) -> f64) -> Self;
 }

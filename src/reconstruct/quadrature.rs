@@ -124,25 +124,37 @@ struct Fields<const D: usize> {
     body: SVector<f64, D>,
 }
 
-/// Density, then the stress column by column, then the body force.
+/// Density, the stress's lower triangle column by column, the body force, and last the
+/// stress above the diagonal (2D), which in a symmetric stress copies the one below.
 impl<const D: usize> Components for Fields<D> {
     const COUNT: usize = 1 + D * D + D;
+    const LAST_MAY_COPY: Option<usize> = if D == 2 { Some(2) } else { None };
 
     #[inline(always)]
     fn component(&self, c: usize) -> f64 {
+        const { assert!(D <= 2, "the quadrature transfers run in 1D and 2D") };
+        let lower = D * (D + 1) / 2;
         match c {
             0 => self.density,
-            c if c <= D * D => self.stress.as_slice()[c - 1],
-            c => self.body[c - 1 - D * D],
+            c if c <= lower => self.stress[[(0, 0), (1, 0), (1, 1)][c - 1]],
+            c if c <= lower + D => self.body[c - 1 - lower],
+            _ => self.stress[(0, 1)],
         }
     }
 
     #[inline(always)]
     fn from_components(component: impl Fn(usize) -> f64) -> Self {
+        let lower = D * (D + 1) / 2;
         Fields {
             density: component(0),
-            stress: SMatrix::from_fn(|i, j| component(1 + i + D * j)),
-            body: SVector::from_fn(|k, _| component(1 + D * D + k)),
+            stress: SMatrix::from_fn(|i, j| {
+                if i >= j {
+                    component(1 + i + j)
+                } else {
+                    component(Self::COUNT - 1)
+                }
+            }),
+            body: SVector::from_fn(|k, _| component(1 + lower + k)),
         }
     }
 }
@@ -529,8 +541,8 @@ mod tests {
         }
     }
 
-    /// The fields' components are density, the stress column by column and the body force,
-    /// and they make the same fields again.
+    /// The fields' components are density, the stress's lower triangle column by column, the
+    /// body force and the stress above the diagonal, and they make the same fields again.
     #[test]
     fn fields_are_their_components() {
         let fields = Fields::<2> {
@@ -541,7 +553,7 @@ mod tests {
         let components: Vec<f64> = (0..Fields::<2>::COUNT)
             .map(|c| fields.component(c))
             .collect();
-        assert_eq!(components, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        assert_eq!(components, [1.0, 2.0, 3.0, 5.0, 6.0, 7.0, 4.0]);
         assert_eq!(Fields::<2>::from_components(|c| components[c]), fields);
         let one = Fields::<1>::from_components(|c| c as f64 + 1.0);
         assert_eq!((one.density, one.stress[0], one.body[0]), (1.0, 2.0, 3.0));

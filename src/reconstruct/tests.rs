@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use super::least_squares::Components;
 use super::*;
 use crate::grid::{Domain, Grid};
 use crate::rng::Lcg;
@@ -464,4 +465,60 @@ fn check_components_apply_apart<const D: usize>() {
 fn an_application_sums_each_component_apart() {
     check_components_apply_apart::<1>();
     check_components_apply_apart::<2>();
+}
+
+/// Seven components, the last of which may copy the third (as the quadrature fields' stress
+/// above its diagonal copies the one below).
+#[derive(Clone, Copy)]
+struct Seven([f64; 7]);
+
+impl Components for Seven {
+    const COUNT: usize = 7;
+    const LAST_MAY_COPY: Option<usize> = Some(2);
+
+    fn component(&self, c: usize) -> f64 {
+        self.0[c]
+    }
+
+    fn from_components(component: impl Fn(usize) -> f64) -> Self {
+        Seven(std::array::from_fn(component))
+    }
+}
+
+/// Values whose last component copies another are summed once for both, to the bit: every
+/// component of the application is the application to that component alone, whether or not
+/// the values copy (`apply_with`'s two paths).
+#[test]
+fn a_copied_component_is_summed_as_its_own() {
+    let g = grid::<2>(5);
+    let x = random_points::<2>(600, 29);
+    let r = recipe(Weight::QuadraticSpline, 1.0, Degree::LINEAR, Solver::Imls);
+    let mut fit = Reconstructor::new(r, Lattice::gauss(&g, 2));
+    fit.fit(&x).unwrap();
+    let n = fit.lattice().len();
+    for copies in [true, false] {
+        let values: Vec<Seven> = x
+            .iter()
+            .map(|p| {
+                let mut v: [f64; 7] =
+                    std::array::from_fn(|c| (c as f64 + 1.0) * p[c % 2] - p[0] * p[1]);
+                v[6] = if copies { v[2] } else { v[2] + 0.5 };
+                Seven(v)
+            })
+            .collect();
+        let mut together = vec![Seven([0.0; 7]); n];
+        fit.apply(&values, &mut together);
+        for c in 0..7 {
+            let component: Vec<f64> = values.iter().map(|v| v.0[c]).collect();
+            let mut apart = vec![0.0; n];
+            fit.apply(&component, &mut apart);
+            for (e, (u, a)) in together.iter().zip(&apart).enumerate() {
+                assert_eq!(
+                    u.0[c].to_bits(),
+                    a.to_bits(),
+                    "copies {copies}, point {e}, component {c}"
+                );
+            }
+        }
+    }
 }
