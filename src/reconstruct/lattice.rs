@@ -6,6 +6,11 @@ use nalgebra::SVector;
 use crate::gauss::gauss_legendre;
 use crate::grid::{index_to_f64, lattice_strides, Dofs, Grid};
 
+/// How far below s - radius, in cells, `near_on_axis` takes a cell's last point to be out
+/// of reach for certain: far above the rounding of (c + offset) - s, a few ulps of c, on
+/// any lattice of under 2^32 cells.
+const EDGE: f64 = 1e-6;
+
 /// Points `lower + (c + offsets[j]) h` per axis (cell c, offset j), numbered with the
 /// offset fastest, then the cell, then the axes with the first fastest.
 #[derive(Clone, Debug)]
@@ -92,11 +97,18 @@ impl<const D: usize> Lattice<D> {
     ) -> usize {
         let k = self.offsets.len();
         let s = (x - self.lower[axis]) / self.h;
-        // A cell below s - radius - (its largest offset) holds no point within the radius:
-        // they lie a whole h further out than rounding can reach. Truncation is floor()
-        // here, from the point's cell down to the first cell, without a libm call; through
-        // i64, which converts in one instruction where usize does not.
-        let first_cell = ((s - radius - self.last_offset()) as i64).max(0) as usize;
+        // Cell c's points lie at c + offset, none past c + (its largest offset): a cell
+        // whose last point lies below s - radius by more than rounding (`EDGE`) holds none
+        // within the radius, and the first cell that may is one past the last such. On
+        // the nonnegative, truncation is floor() without a libm call; through i64, which
+        // converts in one instruction where usize does not. Below the lattice's first
+        // cell, that cell.
+        let below = s - radius - self.last_offset() - EDGE;
+        let first_cell = if below < 0.0 {
+            0
+        } else {
+            below as i64 as usize + 1
+        };
         let last_cell = ((s + radius) as i64).max(0) as usize;
         // Cells, then offsets within a cell: lattice index order without a division. The
         // offsets d grow with the index (rounding is monotone), so the points within the
