@@ -131,6 +131,11 @@ pub struct Reconstructor<const D: usize> {
     /// How the last fit paired the points: its sums, its coefficients and the sums of its
     /// applications.
     fit_pairing: Pairing,
+    /// Which particles the next fit takes two at a time: the pairing under which most pairs
+    /// of the last one reached the same points.
+    particle_pairing: ParticlePairing,
+    /// Which particles the last fit took two at a time; its applications take the same.
+    fit_particle_pairing: ParticlePairing,
     /// The coefficients c_e of the last fit, per pair of points as the sums are: term k's
     /// of both points at `T * pair + k`.
     coeffs: Vec<[f64; 2]>,
@@ -161,6 +166,8 @@ impl<const D: usize> Reconstructor<D> {
             pair_sums: Vec::new(),
             pairing: Pairing::default(),
             fit_pairing: Pairing::default(),
+            particle_pairing: ParticlePairing::default(),
+            fit_particle_pairing: ParticlePairing::default(),
             coeffs: vec![[0.0; 2]; pair_count(points) * terms],
             applied: Vec::new(),
             covered: vec![false; points],
@@ -180,6 +187,12 @@ impl<const D: usize> Reconstructor<D> {
     #[cfg(test)]
     pub(super) fn pairing_phase(&self) -> usize {
         self.pairing.phase
+    }
+
+    /// The phase of the next fit's pairing of the particles (`ParticlePairing`).
+    #[cfg(test)]
+    pub(super) fn particle_pairing_phase(&self) -> usize {
+        self.particle_pairing.phase
     }
 
     /// Whether any particle reached evaluation point `e` in the last fit.
@@ -235,21 +248,36 @@ impl<const D: usize> Reconstructor<D> {
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let mut tables = [PointTables::<D>::new(), PointTables::new()];
-        let (x_pairs, x_rest) = x.as_chunks::<2>();
-        let (v_pairs, v_rest) = v.as_chunks::<2>();
+        let particles = self.particle_pairing;
+        let mut votes = ParticleVotes::default();
+        let alone = |pairs: &mut PairSums<'_, S>,
+                     votes: &mut ParticleVotes<D>,
+                     room: &mut PointTables<D>,
+                     xp,
+                     vp| {
+            let a = room.record().tabulate(&search, xp);
+            votes.note(a.reach);
+            pairs.add_particle::<T, P, D, true>(&a, degree, vp);
+        };
+        let ((x_head, x_pairs, x_tail), (v_head, v_pairs, v_tail)) =
+            (particles.split(x), particles.split(v));
+        for (xp, &vp) in x_head.iter().zip(v_head) {
+            alone(&mut pairs, &mut votes, &mut tables[0], xp, vp);
+        }
         for (xp, vp) in x_pairs.iter().zip(v_pairs) {
             let [a, b] = &mut tables;
             let (a, b) = (a.record(), b.record());
             let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
+            votes.note(tables.0.reach);
+            votes.note(tables.1.reach);
             add_particle_pair::<T, P, S, D, true>(&mut pairs, tables, degree, *vp);
         }
-        for (xp, &vp) in x_rest.iter().zip(v_rest) {
-            let a = tables[0].record().tabulate(&search, xp);
-            for_each_row([&a], |rows| {
-                add_rows::<T, P, S, D, 1, true>(&mut pairs, rows, degree, [vp])
-            });
+        for (xp, &vp) in x_tail.iter().zip(v_tail) {
+            alone(&mut pairs, &mut votes, &mut tables[0], xp, vp);
         }
         self.pairing = pairs.best_pairing();
+        self.particle_pairing = votes.best(particles);
+        self.fit_particle_pairing = particles;
         let pairs = self.pair_sums.as_chunks::<S>().0;
         let sums = |e: usize| {
             let (pair, lane) = pairing.slot(e);
@@ -306,7 +334,8 @@ impl<const D: usize> Reconstructor<D> {
     }
 
     /// Pass one: the lattice points each particle reaches, axis by axis, and the moment
-    /// matrices, summed particle by particle in order. Returns how the sums are paired.
+    /// matrices, summed particle by particle in order. Returns how the sums' points are
+    /// paired.
     fn gather_weights<const T: usize, const P: usize>(&mut self, x: &[SVector<f64, D>]) -> Pairing {
         let record = D * self.slots;
         self.reach.resize(x.len(), Reach::default());
@@ -328,22 +357,34 @@ impl<const D: usize> Reconstructor<D> {
                 offset,
                 factor,
             });
-        let (x_pairs, x_rest) = x.as_chunks::<2>();
+        let particles = self.particle_pairing;
+        let mut votes = ParticleVotes::default();
+        let alone = |pairs: &mut PairSums<'_, P>, votes: &mut ParticleVotes<D>, record, xp| {
+            let a = Record::tabulate(record, &search, xp);
+            votes.note(a.reach);
+            pairs.add_particle::<T, P, D, false>(&a, degree, SVector::zeros());
+        };
+        let (x_head, x_pairs, x_tail) = particles.split(x);
+        for xp in x_head {
+            let record = records.next().expect("a record");
+            alone(&mut pairs, &mut votes, record, xp);
+        }
         for xp in x_pairs {
             let (a, b) = (records.next(), records.next());
             let (a, b) = (a.expect("a record"), b.expect("a record"));
             let tables = (a.tabulate(&search, &xp[0]), b.tabulate(&search, &xp[1]));
+            votes.note(tables.0.reach);
+            votes.note(tables.1.reach);
             let u = [SVector::zeros(); 2];
             add_particle_pair::<T, P, P, D, false>(&mut pairs, tables, degree, u);
         }
-        for xp in x_rest {
-            let a = records.next().expect("a record").tabulate(&search, xp);
-            let u = [SVector::zeros()];
-            for_each_row([&a], |rows| {
-                add_rows::<T, P, P, D, 1, false>(&mut pairs, rows, degree, u)
-            });
+        for xp in x_tail {
+            let record = records.next().expect("a record");
+            alone(&mut pairs, &mut votes, record, xp);
         }
         self.pairing = pairs.best_pairing();
+        self.particle_pairing = votes.best(particles);
+        self.fit_particle_pairing = particles;
         pairing
     }
 
@@ -424,7 +465,14 @@ impl<const D: usize> Reconstructor<D> {
         // Two particles at a time, as the fit summed them: where they reach the same points,
         // each point's sums are loaded and stored once for both.
         let mut tables = self.tables();
-        let (pairs, rest) = values.as_chunks::<2>();
+        let one = |sums: &mut [[[f64; 2]; N]], tables: &AxisTables<'_, D>, u| {
+            apply_particle::<T, N, D>(sums, pairing, tables, u, coeffs, degree);
+        };
+        let (head, pairs, tail) = self.fit_particle_pairing.split(values);
+        for value in head {
+            let a = tables.next().expect("a fit entry");
+            one(sums, &a, components(value));
+        }
         for [value_a, value_b] in pairs {
             let (a, b) = (tables.next(), tables.next());
             let (a, b) = (a.expect("a fit entry"), b.expect("a fit entry"));
@@ -434,19 +482,12 @@ impl<const D: usize> Reconstructor<D> {
                     apply_rows::<T, N, D, 2>(sums, pairing, rows, [u_a, u_b], coeffs, degree);
                 });
             } else {
-                for_each_row([&a], |rows| {
-                    apply_rows::<T, N, D, 1>(sums, pairing, rows, [u_a], coeffs, degree);
-                });
-                for_each_row([&b], |rows| {
-                    apply_rows::<T, N, D, 1>(sums, pairing, rows, [u_b], coeffs, degree);
-                });
+                one(sums, &a, u_a);
+                one(sums, &b, u_b);
             }
         }
-        for (value, tables) in rest.iter().zip(tables) {
-            let u = components(value);
-            for_each_row([&tables], |rows| {
-                apply_rows::<T, N, D, 1>(sums, pairing, rows, [u], coeffs, degree);
-            });
+        for (value, tables) in tail.iter().zip(tables) {
+            one(sums, &tables, components(value));
         }
         let source = |c: usize| match copied {
             Some(of) if c == N => of,
@@ -530,6 +571,22 @@ fn apply_rows<const T: usize, const N: usize, const D: usize, const M: usize>(
     if j < n {
         apply_entries::<T, N, D, 1, M>(&mut applied[pair], &coeffs[pair], 0, j, rows, u, degree);
     }
+}
+
+/// `apply_rows` over every row of one particle's entries, its tables `tables`. One copy
+/// serves every particle applied alone: inlined at each, the copies cost more than the call.
+#[inline(never)]
+fn apply_particle<const T: usize, const N: usize, const D: usize>(
+    applied: &mut [[[f64; 2]; N]],
+    pairing: Pairing,
+    tables: &AxisTables<'_, D>,
+    u: [f64; N],
+    coeffs: &[[[f64; 2]; T]],
+    degree: Degree,
+) {
+    for_each_row([tables], |rows| {
+        apply_rows::<T, N, D, 1>(applied, pairing, rows, [u], coeffs, degree);
+    });
 }
 
 /// `L` consecutive entries of the `M` particles' rows from their `j`-th, on lanes
@@ -677,6 +734,17 @@ struct Reach<const D: usize> {
     count: [usize; D],
 }
 
+impl<const D: usize> Reach<D> {
+    /// Whether `other` is the same runs: the same entries.
+    #[inline(always)]
+    fn same_points(&self, other: &Self) -> bool {
+        (0..D).all(|k| {
+            let n = self.count[k];
+            n == other.count[k] && (n == 0 || self.first[k] == other.first[k])
+        })
+    }
+}
+
 impl<const D: usize> Default for Reach<D> {
     fn default() -> Self {
         Reach {
@@ -703,6 +771,7 @@ impl<const D: usize> PointTables<D> {
     }
 
     /// Its room, as a `Record` to fill.
+    #[inline(always)]
     fn record(&mut self) -> Record<'_, D> {
         Record {
             slots: MAX_PER_AXIS,
@@ -769,10 +838,7 @@ impl<const D: usize> AxisTables<'_, D> {
     /// same, each with its own weights and offsets.
     #[inline(always)]
     fn same_points(&self, other: &Self) -> bool {
-        (0..D).all(|k| {
-            let n = self.reach.count[k];
-            n == other.reach.count[k] && (n == 0 || self.reach.first[k] == other.reach.first[k])
-        })
+        self.reach.same_points(&other.reach)
     }
 }
 
@@ -908,6 +974,73 @@ impl Pairing {
     }
 }
 
+/// Which consecutive particles a fit takes two at a time (`add_particle_pair`): particles
+/// p and p + 1 for every p of the parity `phase`, the first alone under phase 1. Where two
+/// reach the same points, each point's sums are loaded and stored once for both. Which pairs
+/// do depends on the lattice: particles two per cell and axis on IMLS's lattice of two Gauss
+/// points per cell reach the same points across a cell face (phase 1), on the nodes within a
+/// cell (phase 0). The particles' sums run in their order under either phase, so only the
+/// cost depends on it.
+#[derive(Clone, Copy, Debug, Default)]
+struct ParticlePairing {
+    phase: usize,
+}
+
+impl ParticlePairing {
+    /// The particles' `items` as the fit takes them: those before the first pair, the
+    /// pairs, and one left after them.
+    fn split<T>(self, items: &[T]) -> (&[T], &[[T; 2]], &[T]) {
+        let (head, rest) = items.split_at(self.phase.min(items.len()));
+        let (pairs, tail) = rest.as_chunks::<2>();
+        (head, pairs, tail)
+    }
+}
+
+/// Counts, for each phase of `ParticlePairing`, the pairs of a fit's particles, noted in
+/// order, whose runs are the same (`Reach`): no test for runs of no point, which only
+/// particles outside the lattice have.
+struct ParticleVotes<const D: usize> {
+    last: Reach<D>,
+    noted: usize,
+    shared: [usize; 2],
+}
+
+impl<const D: usize> Default for ParticleVotes<D> {
+    fn default() -> Self {
+        ParticleVotes {
+            // No particle's runs: the first one noted pairs with none.
+            last: Reach {
+                first: [usize::MAX; D],
+                count: [usize::MAX; D],
+            },
+            noted: 0,
+            shared: [0; 2],
+        }
+    }
+}
+
+impl<const D: usize> ParticleVotes<D> {
+    /// The next particle reaches `reach`.
+    #[inline(always)]
+    fn note(&mut self, reach: Reach<D>) {
+        let same = reach.first == self.last.first && reach.count == self.last.count;
+        // Particles noted - 1 and noted: a pair under the phase of noted - 1.
+        self.shared[(self.noted + 1) % 2] += usize::from(same);
+        self.last = reach;
+        self.noted += 1;
+    }
+
+    /// The phase under which more pairs reached the same points; `current` on a tie.
+    fn best(&self, current: ParticlePairing) -> ParticlePairing {
+        let other = 1 - current.phase;
+        if self.shared[other] > self.shared[current.phase] {
+            ParticlePairing { phase: other }
+        } else {
+            current
+        }
+    }
+}
+
 /// The sums of one fit under `pairing`, and how many rows began on each lane.
 struct PairSums<'a, const S: usize> {
     sums: &'a mut [[[f64; 2]; S]],
@@ -929,6 +1062,20 @@ impl<'a, const S: usize> PairSums<'a, S> {
         }
     }
 
+    /// Adds one particle's entries (`add_rows`), its tables `tables`. One copy serves every
+    /// particle added alone: inlined at each, the copies cost more than the call.
+    #[inline(never)]
+    fn add_particle<const T: usize, const P: usize, const D: usize, const VELOCITY: bool>(
+        &mut self,
+        tables: &AxisTables<'_, D>,
+        degree: Degree,
+        u: SVector<f64, D>,
+    ) {
+        for_each_row([tables], |rows| {
+            add_rows::<T, P, S, D, 1, VELOCITY>(self, rows, degree, [u]);
+        });
+    }
+
     /// The pairing under which most of this fit's rows would have begun a pair.
     fn best_pairing(&self) -> Pairing {
         let phase = self.pairing.phase;
@@ -943,7 +1090,7 @@ impl<'a, const S: usize> PairSums<'a, S> {
 }
 
 /// Adds two consecutive particles' entries (`add_rows`), with their velocities for a
-/// `fit_apply`: together where they reach the same points (neighbours in a cell), so that
+/// `fit_apply`: together where they reach the same points (`ParticlePairing`), so that
 /// each point's sums are loaded and stored once for both; else one after the other.
 #[inline(always)]
 fn add_particle_pair<
@@ -963,12 +1110,8 @@ fn add_particle_pair<
             add_rows::<T, P, S, D, 2, VELOCITY>(pairs, rows, degree, u);
         });
     } else {
-        for_each_row([&a], |rows| {
-            add_rows::<T, P, S, D, 1, VELOCITY>(pairs, rows, degree, [u[0]]);
-        });
-        for_each_row([&b], |rows| {
-            add_rows::<T, P, S, D, 1, VELOCITY>(pairs, rows, degree, [u[1]]);
-        });
+        pairs.add_particle::<T, P, D, VELOCITY>(&a, degree, u[0]);
+        pairs.add_particle::<T, P, D, VELOCITY>(&b, degree, u[1]);
     }
 }
 

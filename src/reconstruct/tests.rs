@@ -376,9 +376,11 @@ fn a_one_pass_fit_keeps_no_entries_to_apply() {
 
 /// Particles two per cell and axis, jiggled, on a lattice of two Gauss points per cell: every
 /// row of a particle's entries begins on one parity, so after the first fit the pairing of the
-/// points turns to make rows begin pairs (`Pairing`). The next fit at the same positions then
-/// keeps its sums elsewhere and adds half as many entries alone, and must give the same
-/// values to the bit, by `fit` then `apply` and by `fit_apply`.
+/// points turns to make rows begin pairs (`Pairing`); and neighbours across a cell face reach
+/// the same points, so the pairing of the particles turns to take those two at a time
+/// (`ParticlePairing`). The next fit at the same positions then keeps its sums elsewhere and
+/// adds its particles in other groups, and must give the same values to the bit, by `fit`
+/// then `apply` and by `fit_apply`.
 fn check_pairing_changes_no_value<const D: usize>() {
     let g = grid::<D>(6);
     let mut rng = Lcg::new(5 + D as u64);
@@ -401,7 +403,13 @@ fn check_pairing_changes_no_value<const D: usize>() {
     let n = fit.lattice().len();
     let mut runs = Vec::new();
     for _ in 0..2 {
-        let phase = (fit.pairing_phase(), one_pass.pairing_phase());
+        // Of the points, then of the particles.
+        let phase = [
+            fit.pairing_phase(),
+            one_pass.pairing_phase(),
+            fit.particle_pairing_phase(),
+            one_pass.particle_pairing_phase(),
+        ];
         let mut applied = vec![SVector::<f64, D>::zeros(); n];
         let mut fitted = applied.clone();
         let stats = fit.fit(&x).unwrap();
@@ -414,8 +422,8 @@ fn check_pairing_changes_no_value<const D: usize>() {
     };
     assert_eq!(
         (*before, *after),
-        ((0, 0), (1, 1)),
-        "{D}D: the pairing turned"
+        ([0; 4], [1; 4]),
+        "{D}D: the pairings turned"
     );
     let bits = |u: &[SVector<f64, D>]| {
         u.iter()
