@@ -486,8 +486,8 @@ impl<const D: usize> Reconstructor<D> {
                 one(sums, &b, u_b);
             }
         }
-        for (value, tables) in tail.iter().zip(tables) {
-            one(sums, &tables, components(value));
+        for (value, last) in tail.iter().zip(tables) {
+            one(sums, &last, components(value));
         }
         let source = |c: usize| match copied {
             Some(of) if c == N => of,
@@ -997,8 +997,8 @@ impl ParticlePairing {
 }
 
 /// Counts, for each phase of `ParticlePairing`, the pairs of a fit's particles, noted in
-/// order, whose runs are the same (`Reach`): no test for runs of no point, which only
-/// particles outside the lattice have.
+/// order, that reach the same points (`Reach::same_points`, the test `add_particle_pair`
+/// makes).
 struct ParticleVotes<const D: usize> {
     last: Reach<D>,
     noted: usize,
@@ -1008,7 +1008,7 @@ struct ParticleVotes<const D: usize> {
 impl<const D: usize> Default for ParticleVotes<D> {
     fn default() -> Self {
         ParticleVotes {
-            // No particle's runs: the first one noted pairs with none.
+            // No particle's runs (no count is usize::MAX): the first one noted pairs with none.
             last: Reach {
                 first: [usize::MAX; D],
                 count: [usize::MAX; D],
@@ -1023,9 +1023,8 @@ impl<const D: usize> ParticleVotes<D> {
     /// The next particle reaches `reach`.
     #[inline(always)]
     fn note(&mut self, reach: Reach<D>) {
-        let same = reach.first == self.last.first && reach.count == self.last.count;
         // Particles noted - 1 and noted: a pair under the phase of noted - 1.
-        self.shared[(self.noted + 1) % 2] += usize::from(same);
+        self.shared[(self.noted + 1) % 2] += usize::from(reach.same_points(&self.last));
         self.last = reach;
         self.noted += 1;
     }
