@@ -118,13 +118,13 @@ pub struct Reconstructor<const D: usize> {
     /// factor of the points in reach, axis k's from slot `k * slots`.
     axis_offset: Vec<f64>,
     axis_factor: Vec<f64>,
-    /// The sums of the last fit, per pair of evaluation points (`Pairing`): each of its
+    /// Room for a fit's sums, per pair of evaluation points (`Pairing`): each of its
     /// components for both points side by side. They are the moment matrix, packed as
-    /// `packed_len` describes, and after `fit_apply` the moments b_e = sum_p w q u_p of the
+    /// `packed_len` describes, and in `fit_apply` the moments b_e = sum_p w q u_p of the
     /// velocities, term k's component l at `packed_len + 2 k + l` (`sum_components`). A row
     /// of a particle's entries reaches consecutive points, so two of its entries add to a
-    /// pair's sums at once.
-    pair_sums: Vec<[f64; 2]>,
+    /// pair's sums at once. Zero between fits (`ZeroSums`).
+    pair_sums: ZeroSums,
     /// How the next fit pairs the points: the pairing under which most rows of the last
     /// one began a pair.
     pairing: Pairing,
@@ -140,8 +140,8 @@ pub struct Reconstructor<const D: usize> {
     /// of both points at `T * pair + k`.
     coeffs: Vec<[f64; 2]>,
     /// Room for `apply`'s sums, per pair of points as the fit's: component c's of both
-    /// points at `N * pair + c`, for values of N components.
-    applied: Vec<[f64; 2]>,
+    /// points at `N * pair + c`, for values of N components. Zero between applications.
+    applied: ZeroSums,
     covered: Vec<bool>,
 }
 
@@ -163,13 +163,13 @@ impl<const D: usize> Reconstructor<D> {
             reach: Vec::new(),
             axis_offset: Vec::new(),
             axis_factor: Vec::new(),
-            pair_sums: Vec::new(),
+            pair_sums: ZeroSums::default(),
             pairing: Pairing::default(),
             fit_pairing: Pairing::default(),
             particle_pairing: ParticlePairing::default(),
             fit_particle_pairing: ParticlePairing::default(),
             coeffs: vec![[0.0; 2]; pair_count(points) * terms],
-            applied: Vec::new(),
+            applied: ZeroSums::default(),
             covered: vec![false; points],
             lattice,
         }
@@ -244,7 +244,8 @@ impl<const D: usize> Reconstructor<D> {
     ) -> Result<FitStats, SingularMoments> {
         const { assert!(D <= 2 && S == sum_components(T) && P == packed_len(T)) };
         let pairing = self.pairing;
-        let mut pairs = PairSums::<S>::zeroed(&mut self.pair_sums, self.lattice.len(), pairing);
+        let points = self.lattice.len();
+        let mut pairs = PairSums::<S>::zeroed(&mut self.pair_sums, points, pairing);
         let degree = degree_of::<T, D>();
         let search = Search::new(&self.lattice, self.radius, &self.recipe.kernel);
         let mut tables = [PointTables::<D>::new(), PointTables::new()];
@@ -278,19 +279,13 @@ impl<const D: usize> Reconstructor<D> {
         self.pairing = pairs.best_pairing();
         self.particle_pairing = votes.best(particles);
         self.fit_particle_pairing = particles;
-        let pairs = self.pair_sums.as_chunks::<S>().0;
-        let sums = |e: usize| {
-            let (pair, lane) = pairing.slot(e);
-            (&pairs[pair], lane)
-        };
-        let stats = solve_points::<T, P, D>(
+        let pairs = self.pair_sums.chunks_mut::<S>();
+        let stats = solve_points::<T, P, S, D>(
             &self.recipe,
             &self.lattice,
             pairing,
-            |e| {
-                let (sums, lane) = sums(e);
-                std::array::from_fn(|c| sums[c][lane])
-            },
+            pairs,
+            false,
             &mut self.coeffs,
             &mut self.covered,
         )?;
@@ -298,15 +293,20 @@ impl<const D: usize> Reconstructor<D> {
         // u^h(x_e) = c_e . b_e, zero where no particle reaches.
         let coeffs = self.coeffs.as_chunks::<T>().0;
         for (e, u) in out.iter_mut().enumerate() {
+            let (pair, lane) = pairing.slot(e);
+            let sums = &pairs[pair];
             *u = SVector::zeros();
             if self.covered[e] {
-                let (sums, lane) = sums(e);
-                let c = &coeffs[pairing.slot(e).0];
+                let c = &coeffs[pair];
                 for k in 0..T {
                     let b_k = SVector::<f64, D>::from_fn(|l, _| sums[P + 2 * k + l][lane]);
                     *u += b_k * c[k][lane];
                 }
             }
+            zero_when_read(pairs, pair, lane, e + 1 == points);
+        }
+        if out.len() == points {
+            self.pair_sums.mark_zero();
         }
         Ok(stats)
     }
@@ -319,18 +319,17 @@ impl<const D: usize> Reconstructor<D> {
         debug_assert_eq!(P, packed_len(T));
         let pairing = self.gather_weights::<T, P>(x);
         self.fit_pairing = pairing;
-        let pairs = self.pair_sums.as_chunks::<P>().0;
-        solve_points::<T, P, D>(
+        let stats = solve_points::<T, P, P, D>(
             &self.recipe,
             &self.lattice,
             pairing,
-            |e| {
-                let (pair, lane) = pairing.slot(e);
-                std::array::from_fn(|c| pairs[pair][c][lane])
-            },
+            self.pair_sums.chunks_mut::<P>(),
+            true,
             &mut self.coeffs,
             &mut self.covered,
-        )
+        )?;
+        self.pair_sums.mark_zero();
+        Ok(stats)
     }
 
     /// Pass one: the lattice points each particle reaches, axis by axis, and the moment
@@ -456,9 +455,8 @@ impl<const D: usize> Reconstructor<D> {
         let pairing = self.fit_pairing;
         // Taken out of `self` while its tables are read, and put back with its room.
         let mut applied = std::mem::take(&mut self.applied);
-        applied.clear();
-        applied.resize(pair_count(self.lattice.len()) * N, [0.0; 2]);
-        let sums = applied.as_chunks_mut::<N>().0;
+        let points = self.lattice.len();
+        let sums = applied.zeroed::<N>(points);
         let degree = degree_of::<T, D>();
         let coeffs = self.coeffs.as_chunks::<T>().0;
         let components = |v: &V| std::array::from_fn::<f64, N, _>(|c| v.component(c));
@@ -496,6 +494,10 @@ impl<const D: usize> Reconstructor<D> {
         for (e, out) in out.iter_mut().enumerate() {
             let (pair, lane) = pairing.slot(e);
             *out = V::from_components(|c| sums[pair][source(c)][lane]);
+            zero_when_read(sums, pair, lane, e + 1 == points);
+        }
+        if out.len() == points {
+            applied.mark_zero();
         }
         self.applied = applied;
     }
@@ -540,6 +542,54 @@ impl<const D: usize> Components for SVector<f64, D> {
 /// Pairs of points that hold `points` evaluation points under either phase of `Pairing`.
 fn pair_count(points: usize) -> usize {
     points / 2 + 1
+}
+
+/// Sums, per pair of points, that are zero between uses: a use reads each pair once and
+/// zeroes it there (`zero_when_read`), where it is in cache, instead of the next use clearing
+/// the whole array, by then out of cache, before it sums. A use that stops before it has
+/// read every pair (a singular fit) leaves them to be cleared by the next.
+#[derive(Default)]
+struct ZeroSums {
+    sums: Vec<[f64; 2]>,
+    zero: bool,
+}
+
+impl ZeroSums {
+    /// All zero, for `points` evaluation points as pairs of `S` components: sized for either
+    /// phase of `Pairing` (a pair more than the points need), so that they keep their length,
+    /// and their allocation, when the phase changes.
+    fn zeroed<const S: usize>(&mut self, points: usize) -> &mut [[[f64; 2]; S]] {
+        if !self.zero {
+            self.sums.fill([0.0; 2]);
+        }
+        self.sums.resize(pair_count(points) * S, [0.0; 2]);
+        self.zero = false;
+        self.sums.as_chunks_mut::<S>().0
+    }
+
+    /// The sums as pairs of `S` components, as the last `zeroed` gave them.
+    fn chunks_mut<const S: usize>(&mut self) -> &mut [[[f64; 2]; S]] {
+        self.sums.as_chunks_mut::<S>().0
+    }
+
+    /// Every pair was read and zeroed since the last `zeroed`: the next need not clear them.
+    fn mark_zero(&mut self) {
+        self.zero = true;
+    }
+}
+
+/// Zeroes pair `pair` once its last point is read: at its second lane, or at the lattice's
+/// last point.
+#[inline(always)]
+fn zero_when_read<const S: usize>(
+    pairs: &mut [[[f64; 2]; S]],
+    pair: usize,
+    lane: usize,
+    last_point: bool,
+) {
+    if lane == 1 || last_point {
+        pairs[pair] = [[0.0; 2]; S];
+    }
 }
 
 /// u^h += sum_p phi_p(x_e) u_p over the rows `rows` of `M` particles that reach the same
@@ -624,19 +674,27 @@ fn apply_entries<const T: usize, const N: usize, const D: usize, const L: usize,
 }
 
 /// The coefficients c_e at every evaluation point of `lattice`, from its packed moment
-/// matrix `moments(e)`; whether a particle reached it in `covered`.
-fn solve_points<const T: usize, const P: usize, const D: usize>(
+/// matrix, the first `P` of its `S` sums in `pairs` under `pairing`; whether a particle
+/// reached it in `covered`. With `zero`, each pair's sums are zeroed once read.
+fn solve_points<const T: usize, const P: usize, const S: usize, const D: usize>(
     recipe: &Recipe,
     lattice: &Lattice<D>,
     pairing: Pairing,
-    moments: impl Fn(usize) -> [f64; P],
+    pairs: &mut [[[f64; 2]; S]],
+    zero: bool,
     coeffs: &mut [[f64; 2]],
     covered: &mut [bool],
 ) -> Result<FitStats, SingularMoments> {
+    const { assert!(P <= S) };
     let mut stats = FitStats::default();
     let coeffs = coeffs.as_chunks_mut::<T>().0;
+    let points = covered.len();
     for (e, covered) in covered.iter_mut().enumerate() {
-        let a = unpack::<T, P>(&moments(e));
+        let (pair, lane) = pairing.slot(e);
+        let a = unpack::<T, P>(&std::array::from_fn(|c| pairs[pair][c][lane]));
+        if zero {
+            zero_when_read(pairs, pair, lane, e + 1 == points);
+        }
         let a = &a[..];
         *covered = a[0] > 0.0;
         let mut c = [0.0; T];
@@ -660,7 +718,6 @@ fn solve_points<const T: usize, const P: usize, const D: usize>(
                 }
             }
         }
-        let (pair, lane) = pairing.slot(e);
         for (k, c) in c.into_iter().enumerate() {
             coeffs[pair][k][lane] = c;
         }
@@ -1048,14 +1105,10 @@ struct PairSums<'a, const S: usize> {
 }
 
 impl<'a, const S: usize> PairSums<'a, S> {
-    /// `sums` zeroed for `points` evaluation points, as pairs of `S` components. They are
-    /// sized for either phase (a pair more than the points need), so that they keep their
-    /// length, and their allocation, when the phase changes.
-    fn zeroed(sums: &'a mut Vec<[f64; 2]>, points: usize, pairing: Pairing) -> Self {
-        sums.clear();
-        sums.resize(pair_count(points) * S, [0.0; 2]);
+    /// `sums` zeroed for `points` evaluation points, as pairs of `S` components.
+    fn zeroed(sums: &'a mut ZeroSums, points: usize, pairing: Pairing) -> Self {
         PairSums {
-            sums: sums.as_chunks_mut::<S>().0,
+            sums: sums.zeroed::<S>(points),
             pairing,
             starts: [0; 2],
         }
