@@ -285,7 +285,6 @@ impl<const D: usize> Reconstructor<D> {
             &self.lattice,
             pairing,
             pairs,
-            false,
             &mut self.coeffs,
             &mut self.covered,
         )?;
@@ -324,7 +323,6 @@ impl<const D: usize> Reconstructor<D> {
             &self.lattice,
             pairing,
             self.pair_sums.chunks_mut::<P>(),
-            true,
             &mut self.coeffs,
             &mut self.covered,
         )?;
@@ -675,13 +673,13 @@ fn apply_entries<const T: usize, const N: usize, const D: usize, const L: usize,
 
 /// The coefficients c_e at every evaluation point of `lattice`, from its packed moment
 /// matrix, the first `P` of its `S` sums in `pairs` under `pairing`; whether a particle
-/// reached it in `covered`. With `zero`, each pair's sums are zeroed once read.
+/// reached it in `covered`. Where the sums are the moment matrix alone (`S == P`), each pair
+/// is zeroed once read (`ZeroSums`); else the velocity moments after it are still to be read.
 fn solve_points<const T: usize, const P: usize, const S: usize, const D: usize>(
     recipe: &Recipe,
     lattice: &Lattice<D>,
     pairing: Pairing,
     pairs: &mut [[[f64; 2]; S]],
-    zero: bool,
     coeffs: &mut [[f64; 2]],
     covered: &mut [bool],
 ) -> Result<FitStats, SingularMoments> {
@@ -692,7 +690,7 @@ fn solve_points<const T: usize, const P: usize, const S: usize, const D: usize>(
     for (e, covered) in covered.iter_mut().enumerate() {
         let (pair, lane) = pairing.slot(e);
         let a = unpack::<T, P>(&std::array::from_fn(|c| pairs[pair][c][lane]));
-        if zero {
+        if S == P {
             zero_when_read(pairs, pair, lane, e + 1 == points);
         }
         let a = &a[..];

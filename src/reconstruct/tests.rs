@@ -374,6 +374,13 @@ fn a_one_pass_fit_keeps_no_entries_to_apply() {
     rec.apply(&v, &mut out);
 }
 
+/// The bits of every component of `u`, for comparisons to the last bit.
+fn bits<const D: usize>(u: &[SVector<f64, D>]) -> Vec<u64> {
+    u.iter()
+        .flat_map(|u| u.iter().map(|c| c.to_bits()))
+        .collect()
+}
+
 /// Particles two per cell and axis, jiggled, on a lattice of two Gauss points per cell: every
 /// row of a particle's entries begins on one parity, so after the first fit the pairing of the
 /// points turns to make rows begin pairs (`Pairing`); and neighbours across a cell face reach
@@ -425,11 +432,6 @@ fn check_pairing_changes_no_value<const D: usize>() {
         ([0; 4], [1; 4]),
         "{D}D: the pairings turned"
     );
-    let bits = |u: &[SVector<f64, D>]| {
-        u.iter()
-            .flat_map(|u| u.iter().map(|c| c.to_bits()))
-            .collect::<Vec<_>>()
-    };
     assert_eq!(bits(applied_0), bits(applied_1), "{D}D: fit then apply");
     assert_eq!(bits(fitted_0), bits(fitted_1), "{D}D: one pass");
 }
@@ -456,11 +458,6 @@ fn check_reuse_starts_from_zero<const D: usize>() {
             .collect();
         let r = recipe(Weight::QuadraticSpline, 1.0, Degree::LINEAR, Solver::Mls);
         let n = Lattice::nodes(&g).len();
-        let bits = |u: &[SVector<f64, D>]| {
-            u.iter()
-                .flat_map(|u| u.iter().map(|c| c.to_bits()))
-                .collect::<Vec<_>>()
-        };
         let uses = |fit: &mut Reconstructor<D>| {
             let mut applied = vec![SVector::<f64, D>::zeros(); n];
             let mut fitted = applied.clone();
