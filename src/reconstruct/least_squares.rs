@@ -279,34 +279,29 @@ impl<const D: usize> Reconstructor<D> {
         self.pairing = pairs.best_pairing();
         self.particle_pairing = votes.best(particles);
         self.fit_particle_pairing = particles;
-        let pairs = self.pair_sums.chunks_mut::<S>();
         let stats = solve_points::<T, P, S, D>(
             &self.recipe,
             &self.lattice,
             pairing,
-            pairs,
+            self.pair_sums.chunks_mut::<S>(),
             &mut self.coeffs,
             &mut self.covered,
         )?;
         self.fit_pairing = pairing;
         // u^h(x_e) = c_e . b_e, zero where no particle reaches.
         let coeffs = self.coeffs.as_chunks::<T>().0;
-        for (e, u) in out.iter_mut().enumerate() {
-            let (pair, lane) = pairing.slot(e);
-            let sums = &pairs[pair];
-            *u = SVector::zeros();
-            if self.covered[e] {
-                let c = &coeffs[pair];
-                for k in 0..T {
-                    let b_k = SVector::<f64, D>::from_fn(|l, _| sums[P + 2 * k + l][lane]);
-                    *u += b_k * c[k][lane];
+        let covered = &self.covered;
+        self.pair_sums
+            .read_each::<S, _>(points, pairing, out, |e, u, sums, lane| {
+                *u = SVector::zeros();
+                if covered[e] {
+                    let c = &coeffs[pairing.slot(e).0];
+                    for k in 0..T {
+                        let b_k = SVector::<f64, D>::from_fn(|l, _| sums[P + 2 * k + l][lane]);
+                        *u += b_k * c[k][lane];
+                    }
                 }
-            }
-            zero_when_read(pairs, pair, lane, e + 1 == points);
-        }
-        if out.len() == points {
-            self.pair_sums.mark_zero();
-        }
+            });
         Ok(stats)
     }
 
@@ -489,14 +484,9 @@ impl<const D: usize> Reconstructor<D> {
             Some(of) if c == N => of,
             _ => c,
         };
-        for (e, out) in out.iter_mut().enumerate() {
-            let (pair, lane) = pairing.slot(e);
-            *out = V::from_components(|c| sums[pair][source(c)][lane]);
-            zero_when_read(sums, pair, lane, e + 1 == points);
-        }
-        if out.len() == points {
-            applied.mark_zero();
-        }
+        applied.read_each::<N, _>(points, pairing, out, |_, out, sums, lane| {
+            *out = V::from_components(|c| sums[source(c)][lane]);
+        });
         self.applied = applied;
     }
 }
@@ -573,6 +563,28 @@ impl ZeroSums {
     /// Every pair was read and zeroed since the last `zeroed`: the next need not clear them.
     fn mark_zero(&mut self) {
         self.zero = true;
+    }
+
+    /// Reads the sums of the lattice's `points` into `out`, one each from the first, in
+    /// order: `read(e, out[e], e's pair's sums, e's lane)`, zeroing each pair once its last
+    /// point is read. After all `points`, every pair is zero.
+    #[inline(always)]
+    fn read_each<const S: usize, O>(
+        &mut self,
+        points: usize,
+        pairing: Pairing,
+        out: &mut [O],
+        mut read: impl FnMut(usize, &mut O, &[[f64; 2]; S], usize),
+    ) {
+        let pairs = self.chunks_mut::<S>();
+        for (e, out) in out.iter_mut().enumerate() {
+            let (pair, lane) = pairing.slot(e);
+            read(e, out, &pairs[pair], lane);
+            zero_when_read(pairs, pair, lane, e + 1 == points);
+        }
+        if out.len() == points {
+            self.mark_zero();
+        }
     }
 }
 
